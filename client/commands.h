@@ -1,0 +1,12 @@
+// The `vrl` subcommands. Each registers its flags on the app and, when run,
+// stores its process exit code in `exitCode` (0 ok, 1 failure, 2 bad input).
+#pragma once
+
+#include <CLI/CLI.hpp>
+
+namespace vrl {
+
+void registerRenderCommand(CLI::App& app, int& exitCode);
+void registerCompareCommand(CLI::App& app, int& exitCode);
+
+}  // namespace vrl

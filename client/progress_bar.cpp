@@ -1,0 +1,40 @@
+#include "client/progress_bar.h"
+
+#include <unistd.h>
+
+#include <cstdio>
+
+namespace vrl {
+
+ProgressBar::ProgressBar(std::string label)
+    : label_(std::move(label)), terminal_(isatty(STDERR_FILENO) != 0), start_(std::chrono::steady_clock::now()) {}
+
+void ProgressBar::update(double fraction) {
+    std::lock_guard lock(mutex_);
+    if (finished_) return;
+    const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
+    if (terminal_) {
+        const int perMille = int(fraction * 1000.0);
+        if (perMille == lastShown_) return;
+        lastShown_ = perMille;
+        const int width = 40, filled = int(fraction * width);
+        const double eta = fraction > 0.0 ? elapsed * (1.0 - fraction) / fraction : 0.0;
+        std::fprintf(stderr, "\r%s [%s%s] %5.1f%%  %.1fs elapsed, ~%.1fs left ", label_.c_str(),
+                     std::string(filled, '#').c_str(), std::string(width - filled, '.').c_str(), fraction * 100.0,
+                     elapsed, eta);
+    } else {
+        const int tenth = int(fraction * 10.0);
+        if (tenth == lastShown_) return;
+        lastShown_ = tenth;
+        std::fprintf(stderr, "%s %3d%% (%.1fs)\n", label_.c_str(), tenth * 10, elapsed);
+    }
+    std::fflush(stderr);
+}
+
+void ProgressBar::finish() {
+    std::lock_guard lock(mutex_);
+    if (terminal_ && !finished_) std::fprintf(stderr, "\n");
+    finished_ = true;
+}
+
+}  // namespace vrl

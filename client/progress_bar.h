@@ -1,0 +1,26 @@
+// ProgressBar: a thread-safe progress line on stderr. On a terminal it redraws
+// in place; otherwise (logs, CI) it prints a line every 10%.
+#pragma once
+
+#include <chrono>
+#include <mutex>
+#include <string>
+
+namespace vrl {
+
+class ProgressBar {
+public:
+    explicit ProgressBar(std::string label);
+    void update(double fraction);  // safe from any thread; fraction in [0, 1]
+    void finish();
+
+private:
+    std::string label_;
+    std::mutex mutex_;
+    bool terminal_;
+    int lastShown_ = -1;  // per-mille on a terminal, per-ten otherwise
+    bool finished_ = false;
+    std::chrono::steady_clock::time_point start_;
+};
+
+}  // namespace vrl

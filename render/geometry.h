@@ -1,0 +1,52 @@
+// Basic geometric types: points and vectors (Imath), rays, and an orthonormal
+// frame around a direction. World units are the scene's units; angles radians.
+#pragma once
+
+#include <Imath/ImathVec.h>
+
+#include <cmath>
+#include <limits>
+
+namespace vrl {
+
+using Vec3 = Imath::V3f;
+using Vec2 = Imath::V2f;
+
+inline constexpr float kPi = 3.14159265358979323846f;
+inline constexpr float kInvPi = 1.0f / kPi;
+inline constexpr float kInv4Pi = 1.0f / (4.0f * kPi);
+inline constexpr float kInfinity = std::numeric_limits<float>::infinity();
+
+// A ray origin + t * direction for t in (tMin, tMax); direction is unit length.
+// tMin > 0 continues a ray past a surface it crossed without moving its origin,
+// so distances measured along it stay exact.
+struct Ray {
+    Vec3 origin;
+    Vec3 direction;
+    float tMax = kInfinity;
+    float tMin = 0.0f;
+
+    Vec3 at(float t) const { return origin + direction * t; }
+};
+
+// Right-handed orthonormal basis whose z axis is `normal` (Duff et al. 2017).
+struct Frame {
+    Vec3 s, t, n;
+
+    static Frame fromNormal(const Vec3& normal) {
+        const float sign = std::copysign(1.0f, normal.z);
+        const float a = -1.0f / (sign + normal.z);
+        const float b = normal.x * normal.y * a;
+        return {Vec3(1.0f + sign * normal.x * normal.x * a, sign * b, -sign * normal.x),
+                Vec3(b, sign + normal.y * normal.y * a, -normal.y), normal};
+    }
+    Vec3 toWorld(const Vec3& local) const { return s * local.x + t * local.y + n * local.z; }
+    Vec3 toLocal(const Vec3& world) const { return {s.dot(world), t.dot(world), n.dot(world)}; }
+};
+
+// Unit vector from spherical coordinates around +z.
+inline Vec3 sphericalDirection(float sinTheta, float cosTheta, float phi) {
+    return {sinTheta * std::cos(phi), sinTheta * std::sin(phi), cosTheta};
+}
+
+}  // namespace vrl

@@ -1,0 +1,44 @@
+// VolumetricPathTracer: the reference estimator. Unidirectional path tracing
+// through homogeneous media (free-flight sampling with spectral MIS) and diffuse
+// surfaces, with next-event estimation at every medium and surface vertex, and
+// emission counted only where NEE cannot reach it (camera rays and rays that
+// only crossed null boundaries). Unbiased for every light in the scene subset.
+//
+// Path length follows Mitsuba's maxDepth: a path of k scattering vertices has
+// k+1 segments; 1 = directly visible emitters, 2 = + direct lighting and single
+// scattering, -1 = unlimited (Russian roulette ends paths, unbiased).
+#pragma once
+
+#include "render/rng.h"
+#include "render/scene.h"
+
+namespace vrl {
+
+struct PathTracerSettings {
+    int maxDepth = -1;
+    int rouletteDepth = 5;  // scattering vertices before Russian roulette starts
+};
+
+class VolumetricPathTracer {
+public:
+    VolumetricPathTracer(const Scene& scene, PathTracerSettings settings) : scene_(scene), settings_(settings) {}
+
+    // Radiance arriving at ray.origin from ray.direction; the ray starts in `medium`.
+    Rgb radiance(Ray ray, int medium, Rng& rng) const;
+
+private:
+    const Scene& scene_;
+    PathTracerSettings settings_;
+};
+
+// Next-event estimation from `point` (offset from `surface` when given) in
+// `medium`: picks an emitter by power, samples it, and returns the incident
+// radiance times transmittance over the sampling pdf, with its direction.
+struct DirectLighting {
+    Vec3 direction;
+    Rgb radianceOverPdf{0.0f};
+};
+DirectLighting sampleDirectLighting(const Scene& scene, const Vec3& point, const SurfaceHit* surface, int medium,
+                                    Rng& rng);
+
+}  // namespace vrl

@@ -1,0 +1,275 @@
+#include "render/scene.h"
+
+#include "render/shape_mesh.h"
+
+#include <embree3/rtcore.h>
+#include <spdlog/spdlog.h>
+
+#include <cmath>
+#include <stdexcept>
+#include <string>
+
+namespace vrl {
+
+struct Scene::Embree {
+    RTCDevice device = nullptr;
+    RTCScene scene = nullptr;
+    std::string firstError;
+
+    ~Embree() {
+        if (scene) rtcReleaseScene(scene);
+        if (device) rtcReleaseDevice(device);
+    }
+};
+
+namespace {
+
+void embreeErrorCallback(void* userData, RTCError code, const char* message) {
+    auto* embree = static_cast<std::string*>(userData);
+    spdlog::error("Embree error {}: {}", int(code), message ? message : "");
+    if (embree->empty()) embree->assign(message ? message : "unknown Embree error");
+}
+
+Bsdf makeBsdf(const ShapeDescription& shape) {
+    Bsdf bsdf;
+    if (shape.bsdf) {
+        bsdf.kind = shape.bsdf->kind == BsdfDescription::Kind::Null ? Bsdf::Kind::Null : Bsdf::Kind::Diffuse;
+        bsdf.reflectance = shape.bsdf->reflectance;
+        bsdf.twoSided = shape.bsdf->twoSided;
+    } else if ((shape.interiorMedium >= 0 || shape.exteriorMedium >= 0) && !shape.areaRadiance) {
+        bsdf.kind = Bsdf::Kind::Null;  // Mitsuba: a bare shape between media is an invisible boundary
+    }
+    return bsdf;
+}
+
+PhaseFunction makePhase(const PhaseDescription& phase) {
+    return phase.kind == PhaseDescription::Kind::HenyeyGreenstein ? PhaseFunction::henyeyGreenstein(phase.g)
+                                                                  : PhaseFunction::isotropic();
+}
+
+// True if every vertex lies on the inner side of every triangle's plane.
+bool isConvexClosed(const std::vector<const TriangleMesh*>& meshes) {
+    size_t work = 0;
+    for (const auto* m : meshes) work += m->triangles.size();
+    size_t vertices = 0;
+    for (const auto* m : meshes) vertices += m->positions.size();
+    if (work * vertices > 200'000'000) return false;  // too large to check: assume not convex
+    for (const auto* m : meshes) {
+        for (size_t i = 0; i < m->triangles.size(); ++i) {
+            if (m->triangleArea(i) <= 0.0f) continue;
+            const Vec3 n = m->geometricNormal(i);
+            const Vec3 p0 = m->positions[m->triangles[i][0]];
+            for (const auto* other : meshes) {
+                for (const Vec3& p : other->positions) {
+                    const float scale = 1.0f + std::max({std::abs(p.x), std::abs(p.y), std::abs(p.z)});
+                    if (n.dot(p - p0) > 1e-4f * scale) return false;
+                }
+            }
+        }
+    }
+    return true;
+}
+
+}  // namespace
+
+Scene::Scene(const SceneDescription& description) : description_(description), camera_(description.sensor) {}
+
+Scene::~Scene() = default;
+
+std::unique_ptr<Scene> Scene::build(const SceneDescription& description) {
+    std::unique_ptr<Scene> scene(new Scene(description));
+    for (const auto& m : description.media) {
+        try {
+            scene->media_.emplace_back(m.id, m.sigmaS, m.sigmaA, makePhase(m.phase));
+        } catch (const std::invalid_argument& e) {
+            throw SceneError(m.where, e.what());
+        }
+    }
+    const auto checkMedium = [&](int index, const SourceLocation& where) {
+        if (index < -1 || index >= int(scene->media_.size()))
+            throw SceneError(where, "medium index " + std::to_string(index) + " out of range");
+    };
+    checkMedium(description.sensor.medium, description.sensor.where);
+    scene->shapes_.reserve(description.shapes.size());
+    for (const auto& s : description.shapes) {
+        checkMedium(s.interiorMedium, s.where);
+        checkMedium(s.exteriorMedium, s.where);
+        SceneShape shape;
+        shape.mesh = buildShapeMesh(s);
+        shape.bsdf = makeBsdf(s);
+        shape.interiorMedium = s.interiorMedium;
+        shape.exteriorMedium = s.exteriorMedium;
+        shape.changesMedium = s.interiorMedium >= 0 || s.exteriorMedium >= 0;
+        scene->hasNullSurfaces_ = scene->hasNullSurfaces_ || shape.bsdf.isNull();
+        scene->shapes_.push_back(std::move(shape));
+    }
+    // Area emitters reference their mesh: create them only once shapes_ is final.
+    for (size_t i = 0; i < description.shapes.size(); ++i) {
+        const auto& radiance = description.shapes[i].areaRadiance;
+        if (!radiance || isBlack(*radiance)) continue;
+        auto emitter = makeAreaEmitter(scene->shapes_[i].mesh, *radiance);
+        emitter->medium = description.shapes[i].exteriorMedium;
+        scene->shapes_[i].emitter = int(scene->emitters_.size());
+        scene->emitters_.push_back(std::move(emitter));
+    }
+    for (const auto& e : description.emitters) {
+        checkMedium(e.medium, e.where);
+        std::unique_ptr<Emitter> emitter;
+        if (e.kind == EmitterDescription::Kind::Point)
+            emitter = makePointEmitter(e.toWorld.applyPoint(Vec3(0.0f)), e.intensity);
+        else
+            emitter = makeSpotEmitter(e.toWorld, e.intensity, e.cutoffAngle, e.beamWidth);
+        emitter->medium = e.medium >= 0 ? e.medium : description.sensor.medium;
+        scene->emitters_.push_back(std::move(emitter));
+    }
+    if (scene->emitters_.empty()) spdlog::warn("{}: the scene has no emitters; the image will be black", description.file.string());
+    std::vector<const Emitter*> emitters;
+    for (const auto& e : scene->emitters_) emitters.push_back(e.get());
+    scene->emitterSampler_ = std::make_unique<EmitterSampler>(emitters);
+    scene->classifyMediumBoundaries();
+    scene->buildBvh();
+    return scene;
+}
+
+void Scene::classifyMediumBoundaries() {
+    for (size_t m = 0; m < media_.size(); ++m) {
+        std::vector<const TriangleMesh*> bounding;
+        bool enclosesOtherRegion = false;
+        for (const auto& s : shapes_) {
+            if (!s.bsdf.isNull()) continue;  // opaque walls: segments through them have V = 0 anyway
+            if (s.exteriorMedium == int(m)) enclosesOtherRegion = true;
+            if (s.interiorMedium == int(m)) bounding.push_back(&s.mesh);
+        }
+        media_[m].setBoundaryConvex(!enclosesOtherRegion && (bounding.empty() || isConvexClosed(bounding)));
+    }
+}
+
+void Scene::buildBvh() {
+    embree_ = std::make_unique<Embree>();
+    embree_->device = rtcNewDevice(nullptr);
+    if (!embree_->device) throw std::runtime_error("cannot create the Embree device (error " + std::to_string(int(rtcGetDeviceError(nullptr))) + ")");
+    rtcSetDeviceErrorFunction(embree_->device, embreeErrorCallback, &embree_->firstError);
+    embree_->scene = rtcNewScene(embree_->device);
+    rtcSetSceneBuildQuality(embree_->scene, RTC_BUILD_QUALITY_HIGH);
+    for (size_t i = 0; i < shapes_.size(); ++i) {
+        const TriangleMesh& mesh = shapes_[i].mesh;
+        RTCGeometry geometry = rtcNewGeometry(embree_->device, RTC_GEOMETRY_TYPE_TRIANGLE);
+        auto* vertices = static_cast<float*>(rtcSetNewGeometryBuffer(geometry, RTC_BUFFER_TYPE_VERTEX, 0,
+                                                                     RTC_FORMAT_FLOAT3, 3 * sizeof(float),
+                                                                     mesh.positions.size()));
+        auto* indices = static_cast<uint32_t*>(rtcSetNewGeometryBuffer(geometry, RTC_BUFFER_TYPE_INDEX, 0,
+                                                                       RTC_FORMAT_UINT3, 3 * sizeof(uint32_t),
+                                                                       mesh.triangles.size()));
+        if (!vertices || !indices) throw std::runtime_error("Embree could not allocate geometry buffers: " + embree_->firstError);
+        for (size_t v = 0; v < mesh.positions.size(); ++v) {
+            vertices[3 * v] = mesh.positions[v].x;
+            vertices[3 * v + 1] = mesh.positions[v].y;
+            vertices[3 * v + 2] = mesh.positions[v].z;
+        }
+        for (size_t t = 0; t < mesh.triangles.size(); ++t)
+            for (int k = 0; k < 3; ++k) indices[3 * t + k] = mesh.triangles[t][k];
+        rtcCommitGeometry(geometry);
+        rtcAttachGeometryByID(embree_->scene, geometry, unsigned(i));
+        rtcReleaseGeometry(geometry);
+    }
+    rtcCommitScene(embree_->scene);
+    if (!embree_->firstError.empty()) throw std::runtime_error("Embree failed to build the scene: " + embree_->firstError);
+}
+
+std::optional<SurfaceHit> Scene::intersect(const Ray& ray) const {
+    if (shapes_.empty()) return std::nullopt;
+    RTCIntersectContext context;
+    rtcInitIntersectContext(&context);
+    RTCRayHit rayHit{};
+    rayHit.ray.org_x = ray.origin.x;
+    rayHit.ray.org_y = ray.origin.y;
+    rayHit.ray.org_z = ray.origin.z;
+    rayHit.ray.dir_x = ray.direction.x;
+    rayHit.ray.dir_y = ray.direction.y;
+    rayHit.ray.dir_z = ray.direction.z;
+    rayHit.ray.tnear = ray.tMin;
+    rayHit.ray.tfar = ray.tMax;
+    rayHit.ray.mask = ~0u;
+    rayHit.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+    rtcIntersect1(embree_->scene, &context, &rayHit);
+    if (rayHit.hit.geomID == RTC_INVALID_GEOMETRY_ID) return std::nullopt;
+    SurfaceHit hit;
+    hit.t = rayHit.ray.tfar;
+    hit.shape = rayHit.hit.geomID;
+    hit.triangle = rayHit.hit.primID;
+    const TriangleMesh& mesh = shapes_[hit.shape].mesh;
+    const auto& tri = mesh.triangles[hit.triangle];
+    const float u = rayHit.hit.u, v = rayHit.hit.v;
+    hit.position = mesh.positions[tri[0]] * (1 - u - v) + mesh.positions[tri[1]] * u + mesh.positions[tri[2]] * v;
+    hit.geometricNormal = mesh.geometricNormal(hit.triangle);
+    hit.shadingNormal = mesh.shadingNormal(hit.triangle, u, v);
+    if (hit.shadingNormal.dot(hit.geometricNormal) < 0.0f) hit.shadingNormal = -hit.shadingNormal;
+    return hit;
+}
+
+bool Scene::occluded(const Ray& ray) const {
+    if (shapes_.empty()) return false;
+    RTCIntersectContext context;
+    rtcInitIntersectContext(&context);
+    RTCRay r{};
+    r.org_x = ray.origin.x;
+    r.org_y = ray.origin.y;
+    r.org_z = ray.origin.z;
+    r.dir_x = ray.direction.x;
+    r.dir_y = ray.direction.y;
+    r.dir_z = ray.direction.z;
+    r.tnear = ray.tMin;
+    r.tfar = ray.tMax;
+    r.mask = ~0u;
+    rtcOccluded1(embree_->scene, &context, &r);
+    return r.tfar < 0.0f;
+}
+
+Vec3 Scene::offsetOrigin(const SurfaceHit& hit, const Vec3& direction) {
+    const Vec3& p = hit.position;
+    const float scale = 1.0f + std::max({std::abs(p.x), std::abs(p.y), std::abs(p.z)});
+    const float side = direction.dot(hit.geometricNormal) >= 0.0f ? 1.0f : -1.0f;
+    return p + hit.geometricNormal * (side * 1e-4f * scale);
+}
+
+float Scene::tMinPast(const Ray& ray, const SurfaceHit& hit) {
+    const Vec3& p = hit.position;
+    const float scale = 1.0f + std::max({std::abs(p.x), std::abs(p.y), std::abs(p.z)});
+    const float cosine = std::max(std::abs(ray.direction.dot(hit.geometricNormal)), 1e-3f);
+    return hit.t + 1e-4f * scale / cosine;
+}
+
+int Scene::mediumAfter(const SurfaceHit& hit, const Vec3& direction, int currentMedium) const {
+    const SceneShape& shape = shapes_[hit.shape];
+    if (!shape.changesMedium) return currentMedium;
+    return direction.dot(hit.geometricNormal) < 0.0f ? shape.interiorMedium : shape.exteriorMedium;
+}
+
+Rgb Scene::transmittance(const Vec3& from, const Vec3& to, int medium) const {
+    const Vec3 d = to - from;
+    const float distance = d.length();
+    if (!(distance > 0.0f)) return Rgb(1.0f);
+    // Stop short of the target so that an area light's own surface does not occlude.
+    Ray ray{from, d / distance, distance * (1.0f - 1e-4f)};
+    if (!hasNullSurfaces_) {
+        if (occluded(ray)) return Rgb(0.0f);
+        return medium >= 0 ? media_[medium].transmittance(distance) : Rgb(1.0f);
+    }
+    Rgb result(1.0f);
+    float segmentStart = 0.0f;
+    // Walk the one ray through null boundaries (bounded against degenerate meshes).
+    for (int crossings = 0; crossings < 256; ++crossings) {
+        const auto hit = intersect(ray);
+        const float segmentEnd = hit ? hit->t : distance;
+        if (medium >= 0) result *= media_[medium].transmittance(segmentEnd - segmentStart);
+        if (!hit) return result;
+        if (!shapes_[hit->shape].bsdf.isNull()) return Rgb(0.0f);
+        medium = mediumAfter(*hit, ray.direction, medium);
+        segmentStart = hit->t;
+        ray.tMin = tMinPast(ray, *hit);
+        if (ray.tMin >= ray.tMax) return result;
+    }
+    return Rgb(0.0f);
+}
+
+}  // namespace vrl

@@ -1,0 +1,89 @@
+// Scene: the immutable render scene built from a SceneDescription. Owns the
+// world-space meshes, their materials and media links, the media, emitters,
+// camera and the Embree device + BVH (closest-hit and occlusion queries). It is
+// safe to query from many threads at once.
+#pragma once
+
+#include "render/bsdf.h"
+#include "render/camera.h"
+#include "render/emitter.h"
+#include "render/homogeneous_medium.h"
+#include "render/scene_description.h"
+#include "render/triangle_mesh.h"
+
+#include <memory>
+#include <optional>
+#include <vector>
+
+namespace vrl {
+
+struct SceneShape {
+    TriangleMesh mesh;
+    Bsdf bsdf;
+    int emitter = -1;         // index into Scene::emitters(), area lights
+    int interiorMedium = -1;  // -1: vacuum
+    int exteriorMedium = -1;
+    bool changesMedium = false;  // declares interior or exterior (else crossing keeps the medium)
+};
+
+struct SurfaceHit {
+    float t = 0.0f;
+    Vec3 position;
+    Vec3 geometricNormal;  // unit, the mesh's front (outside / emitting) side
+    Vec3 shadingNormal;    // unit, interpolated, on the same side as geometricNormal
+    uint32_t shape = 0;
+    uint32_t triangle = 0;
+};
+
+class Scene {
+public:
+    // Loads meshes and builds the BVH. Throws SceneError for problems in the
+    // description (missing meshes, invalid media) and std::runtime_error for Embree failures.
+    static std::unique_ptr<Scene> build(const SceneDescription& description);
+    ~Scene();
+    Scene(const Scene&) = delete;
+    Scene& operator=(const Scene&) = delete;
+
+    const SceneDescription& description() const { return description_; }
+    const PerspectiveCamera& camera() const { return camera_; }
+    int cameraMedium() const { return description_.sensor.medium; }
+    const std::vector<SceneShape>& shapes() const { return shapes_; }
+    const std::vector<HomogeneousMedium>& media() const { return media_; }
+    const HomogeneousMedium* medium(int index) const { return index >= 0 ? &media_[index] : nullptr; }
+    const std::vector<std::unique_ptr<Emitter>>& emitters() const { return emitters_; }
+    const EmitterSampler& emitterSampler() const { return *emitterSampler_; }
+    bool hasSurfaces() const { return !shapes_.empty(); }
+    bool hasNullSurfaces() const { return hasNullSurfaces_; }
+
+    // Closest surface along the ray within (0, ray.tMax).
+    std::optional<SurfaceHit> intersect(const Ray& ray) const;
+    // True if any surface blocks the segment (origin, origin + t direction), t < tMax.
+    bool occluded(const Ray& ray) const;
+    // Transmittance from `from` (in medium `medium`) to `to`, passing through null
+    // boundaries (switching media) and returning zero at any other surface.
+    Rgb transmittance(const Vec3& from, const Vec3& to, int medium) const;
+    // The medium on the side of `shape` that `direction` points into from `hit`.
+    int mediumAfter(const SurfaceHit& hit, const Vec3& direction, int currentMedium) const;
+
+    // Origin for a ray leaving a surface point in `direction` (offset against self-hits).
+    static Vec3 offsetOrigin(const SurfaceHit& hit, const Vec3& direction);
+    // tMin that continues `ray` past the surface it hit at `hit` (crossing a null boundary).
+    static float tMinPast(const Ray& ray, const SurfaceHit& hit);
+
+private:
+    Scene(const SceneDescription& description);
+    void buildBvh();
+    void classifyMediumBoundaries();
+
+    SceneDescription description_;
+    PerspectiveCamera camera_;
+    std::vector<SceneShape> shapes_;
+    std::vector<HomogeneousMedium> media_;
+    std::vector<std::unique_ptr<Emitter>> emitters_;
+    std::unique_ptr<EmitterSampler> emitterSampler_;
+    bool hasNullSurfaces_ = false;
+    struct Embree;
+    std::unique_ptr<Embree> embree_;
+};
+
+}  // namespace vrl

@@ -1,0 +1,111 @@
+#include "tests/test_scenes.h"
+
+namespace vrl::test {
+
+SensorDescription cameraAtOrigin(int width, int height, float fovDegrees) {
+    SensorDescription sensor;
+    sensor.toWorld = Transform::lookAt(Vec3(0, 0, 0), Vec3(0, 0, 1), Vec3(0, 1, 0));
+    sensor.fov = fovDegrees;
+    sensor.width = width;
+    sensor.height = height;
+    sensor.nearClip = 1e-4f;
+    return sensor;
+}
+
+SceneDescription emittingSphereFurnace(const Rgb& radiance, const Rgb& sigmaS, float g) {
+    SceneDescription scene;
+    scene.sensor = cameraAtOrigin(8, 8, 90.0f);
+    MediumDescription medium;
+    medium.id = "furnace";
+    medium.sigmaS = sigmaS;
+    medium.sigmaA = Rgb(0.0f);
+    if (g != 0.0f) medium.phase = {PhaseDescription::Kind::HenyeyGreenstein, g};
+    scene.media.push_back(medium);
+    scene.sensor.medium = 0;
+    ShapeDescription sphere;
+    sphere.kind = ShapeDescription::Kind::Sphere;
+    sphere.radius = 1.0f;
+    sphere.flipNormals = true;  // emit towards the centre
+    sphere.bsdf = BsdfDescription{BsdfDescription::Kind::Diffuse, Rgb(0.0f), false};
+    sphere.areaRadiance = radiance;
+    sphere.exteriorMedium = 0;  // flipped: the inside is the exterior side
+    scene.shapes.push_back(sphere);
+    return scene;
+}
+
+SceneDescription absorberSlab(const Rgb& radiance, const Rgb& sigmaA, float thickness) {
+    SceneDescription scene;
+    scene.sensor = cameraAtOrigin(9, 9, 20.0f);
+    MediumDescription medium;
+    medium.id = "absorber";
+    medium.sigmaS = Rgb(0.0f);
+    medium.sigmaA = sigmaA;
+    scene.media.push_back(medium);
+    ShapeDescription slab;
+    slab.kind = ShapeDescription::Kind::Cube;
+    slab.toWorld = Transform::scale(Vec3(10.0f, 10.0f, 0.5f * thickness)).then(Transform::translate(Vec3(0, 0, 3)));
+    slab.bsdf = BsdfDescription{BsdfDescription::Kind::Null, Rgb(0.0f), false};
+    slab.interiorMedium = 0;
+    scene.shapes.push_back(slab);
+    ShapeDescription light;
+    light.kind = ShapeDescription::Kind::Rectangle;
+    // Rectangle faces +z; rotate it to face the camera (-z), 8 units away.
+    light.toWorld = Transform::scale(Vec3(5.0f)).then(Transform::rotate(Vec3(1, 0, 0), 180.0f)).then(
+        Transform::translate(Vec3(0, 0, 8)));
+    light.areaRadiance = radiance;
+    scene.shapes.push_back(light);
+    return scene;
+}
+
+SceneDescription pointLightInInfiniteMedium(const Rgb& intensity, const Vec3& lightPosition, const Rgb& sigmaS,
+                                           const Rgb& sigmaA, float g) {
+    SceneDescription scene;
+    scene.sensor = cameraAtOrigin(4, 4, 60.0f);
+    MediumDescription medium;
+    medium.id = "fog";
+    medium.sigmaS = sigmaS;
+    medium.sigmaA = sigmaA;
+    if (g != 0.0f) medium.phase = {PhaseDescription::Kind::HenyeyGreenstein, g};
+    scene.media.push_back(medium);
+    scene.sensor.medium = 0;
+    EmitterDescription light;
+    light.kind = EmitterDescription::Kind::Point;
+    light.intensity = intensity;
+    light.toWorld = Transform::translate(lightPosition);
+    scene.emitters.push_back(light);
+    return scene;
+}
+
+SceneDescription smallSmokeRoom() {
+    SceneDescription scene;
+    scene.sensor = cameraAtOrigin(24, 16, 70.0f);
+    scene.sensor.toWorld = Transform::lookAt(Vec3(0, 0, -1.8f), Vec3(0, -0.3f, 1), Vec3(0, 1, 0));
+    MediumDescription smoke;
+    smoke.id = "smoke";
+    smoke.sigmaS = Rgb(0.3f, 0.35f, 0.4f);
+    smoke.sigmaA = Rgb(0.05f);
+    smoke.phase = {PhaseDescription::Kind::HenyeyGreenstein, 0.5f};
+    scene.media.push_back(smoke);
+    scene.sensor.medium = 0;
+    ShapeDescription room;
+    room.kind = ShapeDescription::Kind::Cube;
+    room.toWorld = Transform::scale(Vec3(2.0f));
+    room.bsdf = BsdfDescription{BsdfDescription::Kind::Diffuse, Rgb(0.6f, 0.5f, 0.4f), true};
+    scene.shapes.push_back(room);
+    ShapeDescription ball;
+    ball.kind = ShapeDescription::Kind::Sphere;
+    ball.center = Vec3(0.5f, -1.4f, 0.8f);
+    ball.radius = 0.6f;
+    ball.bsdf = BsdfDescription{BsdfDescription::Kind::Diffuse, Rgb(0.2f, 0.6f, 0.3f), false};
+    scene.shapes.push_back(ball);
+    EmitterDescription spot;
+    spot.kind = EmitterDescription::Kind::Spot;
+    spot.intensity = Rgb(40.0f);
+    spot.cutoffAngle = 30.0f;
+    spot.beamWidth = 22.0f;
+    spot.toWorld = Transform::lookAt(Vec3(-1.0f, 1.8f, 0.5f), Vec3(0.4f, -2.0f, 0.8f), Vec3(0, 0, 1));
+    scene.emitters.push_back(spot);
+    return scene;
+}
+
+}  // namespace vrl::test

@@ -1,0 +1,31 @@
+// Small scenes built in code (no parser) for the renderer's integration tests,
+// each with a known answer.
+#pragma once
+
+#include "render/scene_description.h"
+
+namespace vrl::test {
+
+// A camera at the origin looking down +z with the given film and fov.
+SensorDescription cameraAtOrigin(int width, int height, float fovDegrees);
+
+// Closed sphere (radius 1, centred on the camera) emitting `radiance` inwards,
+// black walls, filled with a non-absorbing medium of scattering `sigmaS`:
+// every pixel's expected radiance is exactly `radiance`.
+SceneDescription emittingSphereFurnace(const Rgb& radiance, const Rgb& sigmaS, float g);
+
+// A camera in vacuum looking through a slab (thickness `thickness` along z,
+// null boundary) of pure absorber `sigmaA` at a large area light of radiance
+// `radiance` facing the camera: the centre pixels see radiance exp(-sigmaA d).
+SceneDescription absorberSlab(const Rgb& radiance, const Rgb& sigmaA, float thickness);
+
+// A point light of `intensity` at `lightPosition` in an infinite medium that
+// also holds the camera (no surfaces).
+SceneDescription pointLightInInfiniteMedium(const Rgb& intensity, const Vec3& lightPosition, const Rgb& sigmaS,
+                                           const Rgb& sigmaA, float g);
+
+// A closed room (cube of half-size 2) with two-sided diffuse walls, a diffuse
+// sphere, a spot light and a scene-filling medium: a little of everything.
+SceneDescription smallSmokeRoom();
+
+}  // namespace vrl::test
