@@ -46,18 +46,15 @@ public:
     float falloff(float cosTheta) const {
         if (cosTheta <= cosCutoff_) return 0.0f;
         const float theta = std::acos(std::min(1.0f, cosTheta));
-        if (theta <= beam_) return 1.0f;
+        if (theta <= beam_ || cutoff_ <= beam_) return 1.0f;  // beam >= cutoff: a hard cone
         return (cutoff_ - theta) / (cutoff_ - beam_);
     }
     Rgb power() const override {
-        // 2 pi * integral of falloff over cos(theta): exact for the plateau, the
-        // linear ramp integrated numerically (smooth, 64 midpoint steps suffice).
-        double integral = 1.0 - std::cos(beam_);
-        const int steps = 64;
-        for (int i = 0; i < steps; ++i) {
-            const double theta = beam_ + (cutoff_ - beam_) * (i + 0.5) / steps;
-            integral += (cutoff_ - theta) / (cutoff_ - beam_) * std::sin(theta) * (cutoff_ - beam_) / steps;
-        }
+        // 2 pi * integral of falloff(theta) sin(theta) over [0, cutoff]; the linear
+        // ramp (c - theta)/(c - b) integrates in closed form to
+        // 1 - (sin c - sin b)/(c - b) for the plateau and ramp together.
+        const double b = beam_, c = cutoff_;
+        const double integral = c - b > 1e-6 ? 1.0 - (std::sin(c) - std::sin(b)) / (c - b) : 1.0 - std::cos(c);
         return intensity_ * float(2.0 * M_PI * integral);
     }
     DirectLightSample sampleDirect(const Vec3& reference, const Vec2&) const override {

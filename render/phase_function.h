@@ -16,8 +16,10 @@ struct PhaseSample {
 
 class PhaseFunction {
 public:
+    static constexpr float kIsotropicBelow = 1e-6f;  // |g| below this is isotropic
+
     static PhaseFunction isotropic() { return PhaseFunction(0.0f); }
-    // g in (-1, 1); throws std::invalid_argument otherwise.
+    // g in (-1, 1); throws std::invalid_argument otherwise. |g| < kIsotropicBelow is isotropic.
     static PhaseFunction henyeyGreenstein(float g);
 
     float g() const { return g_; }

@@ -16,8 +16,8 @@ struct SourceLocation {
 
     std::string describe() const {
         std::string out = file.empty() ? std::string("<scene>") : file;
-        if (line > 0) out += ":" + std::to_string(line);
-        if (!element.empty()) out += ": in " + element;
+        if (line > 0) out.append(":").append(std::to_string(line));
+        if (!element.empty()) out.append(": in ").append(element);
         return out;
     }
 };
