@@ -5,6 +5,7 @@
 #include "render/mitsuba_parser.h"
 #include "render/renderer.h"
 #include "render/scene.h"
+#include "render/vrl.h"
 
 #include <spdlog/spdlog.h>
 #include <sys/resource.h>
@@ -14,6 +15,7 @@
 #include <chrono>
 #include <cstdio>
 #include <memory>
+#include <mutex>
 #include <regex>
 
 namespace vrl {
@@ -32,6 +34,10 @@ struct RenderCommandOptions {
     int maxDepth = -2;  // -2: the scene's integrator maxDepth
     bool jitter = false;
     bool quiet = false;
+    uint64_t vrls = 100000;
+    uint64_t lightPaths = 0;
+    int vrlSamples = 1;
+    std::string transport = "surface,single,medium-surface,multiple";
 };
 
 double secondsSince(std::chrono::steady_clock::time_point start) {
@@ -85,6 +91,10 @@ int runRender(const RenderCommandOptions& o) {
     settings.seed = o.seed;
     settings.jitter = o.jitter;
     settings.maxDepth = o.maxDepth >= -1 ? o.maxDepth : description.integrator.maxDepth;
+    settings.transports = TransportSelection::parse(o.transport);
+    settings.vrlCount = o.vrls;
+    settings.lightPaths = o.lightPaths;
+    settings.vrlSamples = o.vrlSamples;
     const double parseSeconds = secondsSince(t0);
 
     t0 = Clock::now();
@@ -93,13 +103,25 @@ int runRender(const RenderCommandOptions& o) {
 
     const int threads = o.threads > 0 ? o.threads : tbb::info::default_concurrency();
     tbb::task_arena arena(threads);
-    ProgressBar bar("rendering");
+    // One bar per phase ("light tracing", then "rendering").
+    std::mutex barMutex;
+    std::unique_ptr<ProgressBar> bar;
+    std::string barPhase;
+    const ProgressCallback progress = [&](const char* phase, double f) {
+        {
+            std::lock_guard lock(barMutex);
+            if (barPhase != phase) {
+                if (bar) bar->finish();
+                barPhase = phase;
+                bar = std::make_unique<ProgressBar>(phase);
+            }
+        }
+        bar->update(f);
+    };
     RenderStatistics stats;
     ImageSet images;
-    arena.execute([&] {
-        images = render(*scene, settings, o.quiet ? ProgressCallback{} : [&](double f) { bar.update(f); }, &stats);
-    });
-    bar.finish();
+    arena.execute([&] { images = render(*scene, settings, o.quiet ? ProgressCallback{} : progress, &stats); });
+    if (bar) bar->finish();
 
     t0 = Clock::now();
     images.metadata["vrl.version"] = VRL_VERSION;
@@ -116,6 +138,13 @@ int runRender(const RenderCommandOptions& o) {
     images.metadata["vrl.time.parse"] = std::to_string(parseSeconds);
     images.metadata["vrl.time.build"] = std::to_string(buildSeconds);
     images.metadata["vrl.time.render"] = std::to_string(stats.seconds);
+    if (settings.method == "vrl") {
+        images.metadata["vrl.transport"] = settings.transports.toString();
+        images.metadata["vrl.vrlSamples"] = std::to_string(settings.vrlSamples);
+        images.metadata["vrl.vrlCount"] = std::to_string(stats.vrlCount);
+        images.metadata["vrl.lightPaths"] = std::to_string(stats.lightPaths);
+        images.metadata["vrl.time.lightTracing"] = std::to_string(stats.tracingSeconds);
+    }
     writeExr(o.output, images);
     const double writeSeconds = secondsSince(t0);
 
@@ -130,6 +159,12 @@ int runRender(const RenderCommandOptions& o) {
                  (unsigned long long)stats.cameraSamples,
                  stats.seconds > 0 ? double(stats.cameraSamples) / stats.seconds : 0.0, writeSeconds,
                  o.output.c_str(), peakMemoryMiB());
+    if (settings.method == "vrl") {
+        std::fprintf(stderr, "  light tracing %.3f s: %llu light paths -> %llu VRLs, %.1f MiB (%zu bytes each)\n",
+                     stats.tracingSeconds, (unsigned long long)stats.lightPaths, (unsigned long long)stats.vrlCount,
+                     double(stats.vrlBytes) / (1024.0 * 1024.0), sizeof(Vrl));
+        std::fprintf(stderr, "  transport parts: %s\n", settings.transports.toString().c_str());
+    }
     return 0;
 }
 
@@ -141,7 +176,9 @@ void registerRenderCommand(CLI::App& app, int& exitCode) {
     cmd->add_option("scene", o->scene, "Scene file (Mitsuba 0.5/0.6 XML subset)")->required();
     cmd->add_option("-o,--output", o->output, "Output OpenEXR file")->required();
     cmd->add_option("-D,--define", o->defines, "Override a scene <default>: -D name=value (repeatable)");
-    cmd->add_option("--method", o->method, "Rendering method: path (volumetric path tracer, the reference)")
+    cmd->add_option("--method", o->method,
+                    "Rendering method: path (volumetric path tracer, the reference) or vrl (transport parts "
+                    "(a)-(c) by path sampling, multiple scattering (d) by plain VRLs)")
         ->check(CLI::IsMember(kRenderMethods));
     cmd->add_option("--spp", o->spp, "Samples per pixel (default: the scene's sampler sampleCount)")
         ->check(CLI::Range(1, kMaxSampleCount));
@@ -152,6 +189,15 @@ void registerRenderCommand(CLI::App& app, int& exitCode) {
                     "Path length as Mitsuba's maxDepth: 1 emitters only, 2 direct + single scattering, -1 unlimited "
                     "(default: the scene's integrator)")
         ->check(CLI::Range(-1, 100000));
+    cmd->add_option("--vrls", o->vrls, "vrl: target number of VRLs; whole light paths are traced until reached")
+        ->check(CLI::Range(uint64_t(1), uint64_t(1) << 32));
+    cmd->add_option("--light-paths", o->lightPaths, "vrl: trace exactly this many light paths (overrides --vrls)")
+        ->check(CLI::Range(uint64_t(1), uint64_t(1) << 40));
+    cmd->add_option("--vrl-samples", o->vrlSamples, "vrl: (u, v) samples per VRL and camera segment (default 1)")
+        ->check(CLI::Range(1, 1 << 16));
+    cmd->add_option("--transport", o->transport,
+                    "vrl: parts to render, comma-separated: surface (a), single (b), medium-surface (c), multiple (d); "
+                    "each is also written as an EXR layer (default: all four)");
     cmd->add_flag("--jitter", o->jitter, "Jitter camera rays inside pixels (default: through pixel centres)");
     cmd->add_flag("-q,--quiet", o->quiet, "No progress bar and no informational logs");
     cmd->callback([o, &exitCode] {
@@ -159,6 +205,9 @@ void registerRenderCommand(CLI::App& app, int& exitCode) {
             exitCode = runRender(*o);
         } catch (const SceneError& e) {
             std::fprintf(stderr, "vrl render: scene error: %s\n", e.what());
+            exitCode = 2;
+        } catch (const std::invalid_argument& e) {
+            std::fprintf(stderr, "vrl render: error: %s\n", e.what());
             exitCode = 2;
         } catch (const std::exception& e) {
             std::fprintf(stderr, "vrl render: error: %s\n", e.what());

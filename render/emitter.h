@@ -17,8 +17,8 @@ namespace vrl {
 
 // A point on an emitter seen from a reference point.
 struct DirectLightSample {
-    Vec3 position;      // on the light
-    Vec3 direction;     // unit, from the reference point to `position`
+    Vec3 position{0.0f};   // on the light
+    Vec3 direction{0.0f};  // unit, from the reference point to `position`
     float distance = 0; // |position - reference|
     Rgb weight{0.0f};   // incident radiance / pdf (solid angle), excluding transmittance and visibility
 };

@@ -32,27 +32,34 @@ Vec3 cosineHemisphere(const Vec2& u) {
 
 }  // namespace
 
-Rgb VolumetricPathTracer::radiance(Ray ray, int medium, Rng& rng) const {
+Rgb VolumetricPathTracer::radiance(Ray ray, int medium, Rng& rng, const PathStart& start) const {
     Rgb result(0.0f), throughput(1.0f);
-    int vertices = 0;  // scattering vertices so far (null crossings do not count)
+    int vertices = start.vertices;  // scattering vertices so far (null crossings do not count)
+    bool firstSegment = true;  // until the first scattering vertex
     const int maxDepth = settings_.maxDepth;
     const auto mayScatterAgain = [&] { return maxDepth < 0 || vertices < maxDepth; };
+    // Restriction to medium-medium prefixes: contributions count from the second vertex on.
+    const bool restricted = settings_.onlyMediumToMedium;
+    const auto counts = [&] { return !restricted || vertices >= 2; };
 
     float segmentStart = ray.tMin;  // where the ray entered its current medium
     for (int steps = 0; steps < 100000; ++steps) {
         const auto hit = scene_.intersect(ray);
         const float tSurface = hit ? hit->t : ray.tMax;
 
-        if (medium >= 0) {
+        if (medium >= 0 && firstSegment && start.firstSegmentTransmittanceOnly) {
+            throughput *= scene_.media()[medium].transmittance(tSurface - segmentStart);
+        } else if (medium >= 0) {
             const HomogeneousMedium& m = scene_.media()[medium];
             const FreeFlightSample flight = m.sampleFreeFlight(tSurface - segmentStart, rng.next(), rng.next());
             throughput *= flight.weight;
             if (flight.scattered) {
                 ++vertices;
+                firstSegment = false;
                 if (!mayScatterAgain()) break;
                 const Vec3 x = ray.at(segmentStart + flight.t);
                 const DirectLighting direct = sampleDirectLighting(scene_, x, nullptr, medium, rng);
-                if (!isBlack(direct.radianceOverPdf))
+                if (counts() && !isBlack(direct.radianceOverPdf))
                     result += throughput * direct.radianceOverPdf * m.phase().eval(ray.direction, direct.direction);
                 // Exact phase sampling: the weight f/pdf is 1.
                 const PhaseSample next = m.phase().sample(ray.direction, Vec2(rng.next(), rng.next()));
@@ -70,7 +77,7 @@ Rgb VolumetricPathTracer::radiance(Ray ray, int medium, Rng& rng) const {
 
         const SceneShape& shape = scene_.shapes()[hit->shape];
         // Emission: only for paths NEE has not already accounted for.
-        if (vertices == 0 && shape.emitter >= 0)
+        if (start.emissionOnFirstHit && vertices == start.vertices && !restricted && shape.emitter >= 0)
             result += throughput * scene_.emitters()[shape.emitter]->emittedRadiance(hit->geometricNormal, -ray.direction);
 
         if (shape.bsdf.isNull()) {
@@ -79,6 +86,8 @@ Rgb VolumetricPathTracer::radiance(Ray ray, int medium, Rng& rng) const {
             ray.tMin = Scene::tMinPast(ray, *hit);  // same ray: distances stay exact
             continue;
         }
+        firstSegment = false;
+        if (restricted && vertices + 1 <= 2) break;  // a surface among the first two vertices
 
         // Diffuse reflection on the side the ray arrived from.
         Vec3 n = hit->shadingNormal;
@@ -92,7 +101,7 @@ Rgb VolumetricPathTracer::radiance(Ray ray, int medium, Rng& rng) const {
         const Rgb albedo = shape.bsdf.reflectance;
         const DirectLighting direct = sampleDirectLighting(scene_, hit->position, &*hit, medium, rng);
         const float ng = direct.direction.dot(hit->geometricNormal) * (front ? 1.0f : -1.0f);
-        if (!isBlack(direct.radianceOverPdf) && ng > 0.0f)
+        if (counts() && !isBlack(direct.radianceOverPdf) && ng > 0.0f)
             result += throughput * direct.radianceOverPdf * albedo * (std::max(0.0f, direct.direction.dot(n)) * kInvPi);
 
         const Vec3 dir = Frame::fromNormal(n).toWorld(cosineHemisphere(Vec2(rng.next(), rng.next()))).normalized();

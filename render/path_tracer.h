@@ -17,6 +17,18 @@ namespace vrl {
 struct PathTracerSettings {
     int maxDepth = -1;
     int rouletteDepth = 5;  // scattering vertices before Russian roulette starts
+    // Count only paths whose first two camera-side vertices lie in a medium
+    // (the paths VRLs estimate); everything else is dropped.
+    bool onlyMediumToMedium = false;
+};
+
+// Where a path starts, for estimators that hand part of a path to the tracer.
+struct PathStart {
+    int vertices = 0;  // scattering vertices already on the path (camera side)
+    // Cross the first segment (up to the first non-null surface) with its exact
+    // transmittance, sampling no medium collision on it.
+    bool firstSegmentTransmittanceOnly = false;
+    bool emissionOnFirstHit = true;  // count an emitter hit at the end of that segment
 };
 
 class VolumetricPathTracer {
@@ -24,7 +36,7 @@ public:
     VolumetricPathTracer(const Scene& scene, PathTracerSettings settings) : scene_(scene), settings_(settings) {}
 
     // Radiance arriving at ray.origin from ray.direction; the ray starts in `medium`.
-    Rgb radiance(Ray ray, int medium, Rng& rng) const;
+    Rgb radiance(Ray ray, int medium, Rng& rng, const PathStart& start = {}) const;
 
 private:
     const Scene& scene_;

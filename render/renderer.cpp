@@ -1,6 +1,8 @@
 #include "render/renderer.h"
 
+#include "render/light_tracer.h"
 #include "render/path_tracer.h"
+#include "render/vrl_integrator.h"
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
@@ -12,6 +14,101 @@
 
 namespace vrl {
 
+namespace {
+
+// Runs `shadePixel(x, y, rng)` over all pixels in parallel tiles, each pixel with
+// its own stream (seed, pixel index).
+template <class ShadePixel>
+void forEachPixel(int width, int height, const RenderSettings& settings, const ProgressCallback& progress,
+                  ShadePixel&& shadePixel) {
+    const int tile = std::max(1, settings.tileSize);
+    const int tilesX = (width + tile - 1) / tile, tilesY = (height + tile - 1) / tile;
+    std::atomic<long long> pixelsDone{0};
+    const double totalPixels = double(width) * height;
+    tbb::parallel_for(tbb::blocked_range<int>(0, tilesX * tilesY, 1), [&](const tbb::blocked_range<int>& range) {
+        for (int t = range.begin(); t < range.end(); ++t) {
+            const int x0 = (t % tilesX) * tile, y0 = (t / tilesX) * tile;
+            const int x1 = std::min(width, x0 + tile), y1 = std::min(height, y0 + tile);
+            for (int y = y0; y < y1; ++y) {
+                for (int x = x0; x < x1; ++x) {
+                    Rng rng(settings.seed, uint64_t(y) * uint64_t(width) + uint64_t(x));
+                    shadePixel(x, y, rng);
+                }
+            }
+            const long long count = static_cast<long long>(x1 - x0) * (y1 - y0);
+            const long long done = pixelsDone.fetch_add(count) + count;
+            if (progress) progress("rendering", double(done) / totalPixels);
+        }
+    });
+}
+
+Ray cameraRay(const PerspectiveCamera& camera, const RenderSettings& settings, int x, int y, Rng& rng) {
+    const float jx = settings.jitter ? rng.next() : 0.5f;
+    const float jy = settings.jitter ? rng.next() : 0.5f;
+    return camera.generateRay(float(x) + jx, float(y) + jy);
+}
+
+ImageSet renderPath(const Scene& scene, const RenderSettings& settings, const ProgressCallback& progress) {
+    const PerspectiveCamera& camera = scene.camera();
+    ImageSet result;
+    result.image = Image(camera.width(), camera.height());
+    const VolumetricPathTracer tracer(scene, PathTracerSettings{settings.maxDepth});
+    forEachPixel(camera.width(), camera.height(), settings, progress, [&](int x, int y, Rng& rng) {
+        Rgb sum(0.0f);
+        for (int s = 0; s < settings.samplesPerPixel; ++s)
+            sum += tracer.radiance(cameraRay(camera, settings, x, y, rng), scene.cameraMedium(), rng);
+        result.image.at(x, y) = sum / float(settings.samplesPerPixel);
+    });
+    return result;
+}
+
+ImageSet renderVrl(const Scene& scene, const RenderSettings& settings, const ProgressCallback& progress,
+                   RenderStatistics& statistics) {
+    VrlSet vrls;
+    if (settings.transports.has(TransportPart::Multiple)) {
+        LightTracingSettings tracing;
+        tracing.lightPaths = settings.lightPaths;
+        tracing.targetVrls = settings.vrlCount;
+        tracing.maxDepth = settings.maxDepth;
+        tracing.seed = settings.seed ^ 0x5bd1e995ULL;  // a stream family apart from the camera's
+        vrls = traceVrls(scene, tracing, [&](double f) {
+            if (progress) progress("light tracing", f);
+        });
+        statistics.vrlCount = vrls.vrls.size();
+        statistics.lightPaths = vrls.lightPaths;
+        statistics.vrlBytes = vrls.memoryBytes();
+        statistics.tracingSeconds = vrls.tracingSeconds;
+    }
+    const auto start = std::chrono::steady_clock::now();
+    const PerspectiveCamera& camera = scene.camera();
+    const int width = camera.width(), height = camera.height();
+    VrlIntegratorSettings integratorSettings{settings.transports, settings.maxDepth, settings.vrlSamples};
+    const VrlIntegrator integrator(scene, vrls, integratorSettings);
+    std::array<Image, 4> parts;
+    for (auto& part : parts) part = Image(width, height);
+    forEachPixel(width, height, settings, progress, [&](int x, int y, Rng& rng) {
+        std::array<Rgb, 4> sum{Rgb(0.0f), Rgb(0.0f), Rgb(0.0f), Rgb(0.0f)};
+        for (int s = 0; s < settings.samplesPerPixel; ++s) {
+            const auto sample = integrator.samplePathParts(cameraRay(camera, settings, x, y, rng), rng);
+            for (size_t p = 0; p < 3; ++p) sum[p] += sample[p];
+        }
+        for (size_t p = 0; p < 3; ++p) parts[p].at(x, y) = sum[p] / float(settings.samplesPerPixel);
+        // (d) once per pixel: its cost is per VRL, not per camera sample.
+        parts[3].at(x, y) = integrator.multipleScattering(cameraRay(camera, settings, x, y, rng), rng);
+    });
+    ImageSet result;
+    result.image = Image(width, height);
+    for (size_t p = 0; p < parts.size(); ++p) {
+        if (!settings.transports.enabled[p]) continue;
+        for (size_t i = 0; i < result.image.pixelCount(); ++i) result.image[i] += parts[p][i];
+        result.layers.emplace_back(std::string(kTransportPartNames[p]), std::move(parts[p]));
+    }
+    statistics.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    return result;
+}
+
+}  // namespace
+
 ImageSet render(const Scene& scene, const RenderSettings& settings, const ProgressCallback& progress,
                 RenderStatistics* statistics) {
     if (std::find(kRenderMethods.begin(), kRenderMethods.end(), settings.method) == kRenderMethods.end()) {
@@ -20,44 +117,18 @@ ImageSet render(const Scene& scene, const RenderSettings& settings, const Progre
         throw std::invalid_argument("unknown method '" + settings.method + "' (valid: " + valid + ")");
     }
     if (settings.samplesPerPixel < 1) throw std::invalid_argument("samples per pixel must be at least 1");
-    const auto start = std::chrono::steady_clock::now();
-    const PerspectiveCamera& camera = scene.camera();
-    const int width = camera.width(), height = camera.height(), tile = std::max(1, settings.tileSize);
-    const int tilesX = (width + tile - 1) / tile, tilesY = (height + tile - 1) / tile;
-
+    if (settings.vrlSamples < 1) throw std::invalid_argument("samples per VRL must be at least 1");
+    RenderStatistics stats;
     ImageSet result;
-    result.image = Image(width, height);
-    const VolumetricPathTracer tracer(scene, PathTracerSettings{settings.maxDepth});
-    std::atomic<long long> pixelsDone{0};
-    const double totalPixels = double(width) * height;
-
-    tbb::parallel_for(tbb::blocked_range<int>(0, tilesX * tilesY, 1), [&](const tbb::blocked_range<int>& range) {
-        for (int t = range.begin(); t < range.end(); ++t) {
-            const int x0 = (t % tilesX) * tile, y0 = (t / tilesX) * tile;
-            const int x1 = std::min(width, x0 + tile), y1 = std::min(height, y0 + tile);
-            for (int y = y0; y < y1; ++y) {
-                for (int x = x0; x < x1; ++x) {
-                    const uint64_t pixelIndex = uint64_t(y) * uint64_t(width) + uint64_t(x);
-                    Rng rng(settings.seed, pixelIndex);
-                    Rgb sum(0.0f);
-                    for (int s = 0; s < settings.samplesPerPixel; ++s) {
-                        const float jx = settings.jitter ? rng.next() : 0.5f;
-                        const float jy = settings.jitter ? rng.next() : 0.5f;
-                        const Ray ray = camera.generateRay(float(x) + jx, float(y) + jy);
-                        sum += tracer.radiance(ray, scene.cameraMedium(), rng);
-                    }
-                    result.image.at(x, y) = sum / float(settings.samplesPerPixel);
-                }
-            }
-            const long long done = pixelsDone.fetch_add(static_cast<long long>((x1 - x0) * (y1 - y0))) + (x1 - x0) * (y1 - y0);
-            if (progress) progress(double(done) / totalPixels);
-        }
-    });
-
-    if (statistics) {
-        statistics->seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-        statistics->cameraSamples = uint64_t(width) * height * settings.samplesPerPixel;
+    if (settings.method == "vrl") {
+        result = renderVrl(scene, settings, progress, stats);
+    } else {
+        const auto start = std::chrono::steady_clock::now();
+        result = renderPath(scene, settings, progress);
+        stats.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     }
+    stats.cameraSamples = uint64_t(scene.camera().width()) * scene.camera().height() * settings.samplesPerPixel;
+    if (statistics) *statistics = stats;
     return result;
 }
 

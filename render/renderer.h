@@ -5,6 +5,7 @@
 
 #include "render/image.h"
 #include "render/scene.h"
+#include "render/transport.h"
 
 #include <cstdint>
 #include <functional>
@@ -14,26 +15,40 @@
 namespace vrl {
 
 // Methods the renderer knows; `vrl render --method` takes these names.
-inline const std::vector<std::string> kRenderMethods = {"path"};
+//   path: the volumetric path tracer (reference), one image
+//   vrl:  the four transport parts, multiple scattering by plain VRLs; one layer per part
+inline const std::vector<std::string> kRenderMethods = {"path", "vrl"};
 
 struct RenderSettings {
     std::string method = "path";
-    int samplesPerPixel = 1;
+    int samplesPerPixel = 1;  // path: per pixel; vrl: for parts (a)-(c)
     uint64_t seed = 0;
     bool jitter = false;  // false: rays through pixel centres (the paper's setting)
     int maxDepth = -1;    // Mitsuba meaning (see path_tracer.h)
     int tileSize = 16;
+    // vrl method
+    TransportSelection transports;
+    uint64_t vrlCount = 100000;  // target VRLs (whole light paths are kept)
+    uint64_t lightPaths = 0;     // if > 0: trace exactly this many light paths instead
+    int vrlSamples = 1;          // (u, v) samples per VRL and camera segment
 };
 
 struct RenderStatistics {
-    double seconds = 0.0;
+    double seconds = 0.0;  // shading (after light tracing)
     uint64_t cameraSamples = 0;
+    // vrl method
+    uint64_t vrlCount = 0;
+    uint64_t lightPaths = 0;
+    size_t vrlBytes = 0;
+    double tracingSeconds = 0.0;
 };
 
-// Called from worker threads with the fraction of pixels done; must be thread-safe.
-using ProgressCallback = std::function<void(double fraction)>;
+// Called from worker threads with the fraction done of a phase ("light tracing",
+// "rendering"); must be thread-safe.
+using ProgressCallback = std::function<void(const char* phase, double fraction)>;
 
 // Throws std::invalid_argument for an unknown method or non-positive sample count.
+// The vrl method returns the sum in .image and each selected part as a layer.
 ImageSet render(const Scene& scene, const RenderSettings& settings, const ProgressCallback& progress = {},
                 RenderStatistics* statistics = nullptr);
 

@@ -2,9 +2,11 @@
 
 #include "render/shape_mesh.h"
 
+#include <Imath/ImathBox.h>
 #include <embree3/rtcore.h>
 #include <spdlog/spdlog.h>
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 #include <string>
@@ -108,7 +110,10 @@ std::unique_ptr<Scene> Scene::build(const SceneDescription& description) {
         const auto& radiance = description.shapes[i].areaRadiance;
         if (!radiance || isBlack(*radiance)) continue;
         auto emitter = makeAreaEmitter(scene->shapes_[i].mesh, *radiance);
-        emitter->medium = description.shapes[i].exteriorMedium;
+        // The side it emits into; a shape that declares no media sits in the camera's (ambient) medium.
+        const auto& shape = description.shapes[i];
+        emitter->medium = shape.interiorMedium >= 0 || shape.exteriorMedium >= 0 ? shape.exteriorMedium
+                                                                                 : description.sensor.medium;
         scene->shapes_[i].emitter = int(scene->emitters_.size());
         scene->emitters_.push_back(std::move(emitter));
     }
@@ -132,15 +137,41 @@ std::unique_ptr<Scene> Scene::build(const SceneDescription& description) {
 }
 
 void Scene::classifyMediumBoundaries() {
+    mediumNeedsVisibility_.assign(media_.size(), true);
     for (size_t m = 0; m < media_.size(); ++m) {
         std::vector<const TriangleMesh*> bounding;
+        std::vector<size_t> boundingShapes;
         bool enclosesOtherRegion = false;
-        for (const auto& s : shapes_) {
+        for (size_t i = 0; i < shapes_.size(); ++i) {
+            const auto& s = shapes_[i];
+            if (s.interiorMedium == int(m)) boundingShapes.push_back(i);
             if (!s.bsdf.isNull()) continue;  // opaque walls: segments through them have V = 0 anyway
             if (s.exteriorMedium == int(m)) enclosesOtherRegion = true;
             if (s.interiorMedium == int(m)) bounding.push_back(&s.mesh);
         }
-        media_[m].setBoundaryConvex(!enclosesOtherRegion && (bounding.empty() || isConvexClosed(bounding)));
+        const bool convex = !enclosesOtherRegion && (bounding.empty() || isConvexClosed(bounding));
+        media_[m].setBoundaryConvex(convex);
+        // Occlusion-free: no shapes at all, or a convex boundary (all shapes that have the
+        // medium inside) whose box no other shape's box overlaps.
+        if (shapes_.empty()) {
+            mediumNeedsVisibility_[m] = false;
+            continue;
+        }
+        if (!convex || boundingShapes.empty()) continue;
+        std::vector<const TriangleMesh*> boundary;
+        for (size_t i : boundingShapes) boundary.push_back(&shapes_[i].mesh);
+        if (!isConvexClosed(boundary)) continue;
+        Imath::Box3f box;
+        for (const auto* mesh : boundary)
+            for (const auto& p : mesh->positions) box.extendBy(p);
+        bool somethingInside = false;
+        for (size_t i = 0; i < shapes_.size() && !somethingInside; ++i) {
+            if (std::find(boundingShapes.begin(), boundingShapes.end(), i) != boundingShapes.end()) continue;
+            Imath::Box3f other;
+            for (const auto& p : shapes_[i].mesh.positions) other.extendBy(p);
+            somethingInside = box.intersects(other);
+        }
+        mediumNeedsVisibility_[m] = somethingInside;
     }
 }
 

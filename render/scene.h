@@ -53,6 +53,9 @@ public:
     const std::vector<std::unique_ptr<Emitter>>& emitters() const { return emitters_; }
     const EmitterSampler& emitterSampler() const { return *emitterSampler_; }
     bool hasSurfaces() const { return !shapes_.empty(); }
+    // False when segments between two points of the medium can never be blocked:
+    // its boundary is convex and nothing else lies inside it (no occlusion rays needed).
+    bool mediumNeedsVisibility(int medium) const { return medium < 0 || mediumNeedsVisibility_[medium]; }
     bool hasNullSurfaces() const { return hasNullSurfaces_; }
 
     // Closest surface along the ray within (0, ray.tMax).
@@ -82,6 +85,7 @@ private:
     std::vector<std::unique_ptr<Emitter>> emitters_;
     std::unique_ptr<EmitterSampler> emitterSampler_;
     bool hasNullSurfaces_ = false;
+    std::vector<bool> mediumNeedsVisibility_;
     struct Embree;
     std::unique_ptr<Embree> embree_;
 };

@@ -1,0 +1,172 @@
+#include "render/light_tracer.h"
+
+#include "render/rng.h"
+
+#include <spdlog/spdlog.h>
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <stdexcept>
+
+namespace vrl {
+
+namespace {
+
+constexpr uint64_t kPathsPerChunk = 64;
+constexpr uint64_t kChunksPerBatch = 32;
+
+Vec3 cosineHemisphere(const Vec2& u) {
+    const float r = std::sqrt(u.x), phi = 2.0f * kPi * u.y;
+    return {r * std::cos(phi), r * std::sin(phi), std::sqrt(std::max(0.0f, 1.0f - u.x))};
+}
+
+class LightPathTracer {
+public:
+    LightPathTracer(const Scene& scene, const LightTracingSettings& settings) : scene_(scene), settings_(settings) {}
+
+    // Appends the VRLs of light path `index` to `out` (flux not yet divided by the path count).
+    void trace(uint64_t index, std::vector<Vrl>& out) const {
+        const EmitterSampler& sampler = scene_.emitterSampler();
+        if (sampler.empty()) return;
+        Rng rng(settings_.seed, index);
+        const auto [emitterIndex, probability] = sampler.sample(rng.next());
+        const Emitter& emitter = *scene_.emitters()[emitterIndex];
+        const Vec2 uPosition(rng.next(), rng.next()), uDirection(rng.next(), rng.next());
+        const EmissionSample emission = emitter.sampleEmission(uPosition, uDirection);
+        Rgb throughput = emission.weight / probability;
+        if (isBlack(throughput) || !isFinite(throughput)) return;
+        const float initial = maxComponent(throughput);
+
+        Ray ray = emission.ray;
+        const Vec3& p = ray.origin;
+        ray.tMin = 1e-4f * (1.0f + std::max({std::abs(p.x), std::abs(p.y), std::abs(p.z)}));  // leave the emitter
+        int medium = emitter.medium;
+        int vertices = 0;  // real scattering vertices so far; the current segment is number vertices + 1
+        float segmentStart = 0.0f;
+        const auto keepsVrls = [&] { return settings_.maxDepth < 0 || vertices + 3 <= settings_.maxDepth; };
+        const auto roulette = [&] {
+            if (vertices < settings_.rouletteDepth) return true;
+            const float q = std::min(0.95f, maxComponent(throughput) / initial);
+            if (rng.next() >= q) return false;
+            throughput /= q;
+            return true;
+        };
+
+        for (int steps = 0; steps < 100000 && keepsVrls(); ++steps) {
+            const auto hit = scene_.intersect(ray);
+            const float tSurface = hit ? hit->t : kInfinity;
+            bool scattered = false;
+            if (medium >= 0) {
+                const HomogeneousMedium& m = scene_.media()[medium];
+                if (m.isNonScattering()) {
+                    throughput *= m.transmittance(tSurface - segmentStart);
+                } else {
+                    // Spectral tracking against the majorant: each collision-free stretch is one VRL.
+                    const Rgb sigmaT = m.sigmaT(), sigmaS = m.sigmaS();
+                    const float majorant = maxComponent(sigmaT);
+                    const float nullWeight = average(Rgb(majorant) - sigmaT), realWeight = average(sigmaS);
+                    const float pReal = realWeight / (realWeight + nullWeight);
+                    while (true) {
+                        const float t = segmentStart - std::log1p(-rng.next()) / majorant;
+                        const float end = std::min(t, tSurface);
+                        if (std::isfinite(end) && end > segmentStart)
+                            out.push_back({ray.at(segmentStart), ray.direction, end - segmentStart, throughput, medium});
+                        if (t >= tSurface) break;
+                        segmentStart = t;
+                        if (rng.next() < pReal) {
+                            throughput *= sigmaS / (majorant * pReal);
+                            scattered = true;
+                            break;
+                        }
+                        throughput *= (Rgb(majorant) - sigmaT) / (majorant * (1.0f - pReal));
+                        if (isBlack(throughput)) return;
+                    }
+                }
+            }
+            if (scattered) {
+                ++vertices;
+                const Vec3 x = ray.at(segmentStart);
+                const PhaseSample next = scene_.media()[medium].phase().sample(ray.direction, Vec2(rng.next(), rng.next()));
+                ray = Ray{x, next.direction};
+                segmentStart = 0.0f;
+                if (!roulette()) return;
+                continue;
+            }
+            if (!hit || isBlack(throughput)) return;
+            const SceneShape& shape = scene_.shapes()[hit->shape];
+            if (shape.bsdf.isNull()) {
+                medium = scene_.mediumAfter(*hit, ray.direction, medium);
+                segmentStart = hit->t;
+                ray.tMin = Scene::tMinPast(ray, *hit);
+                continue;
+            }
+            // Diffuse bounce about the geometric normal: the cosine-sampled weight is
+            // then exactly the albedo (shading normals would need the adjoint correction).
+            Vec3 n = hit->geometricNormal;
+            const bool front = ray.direction.dot(hit->geometricNormal) < 0.0f;
+            if (!front) {
+                if (!shape.bsdf.twoSided) return;
+                n = -n;
+            }
+            ++vertices;
+            const Vec3 dir = Frame::fromNormal(n).toWorld(cosineHemisphere(Vec2(rng.next(), rng.next()))).normalized();
+            throughput *= shape.bsdf.reflectance;
+            medium = scene_.mediumAfter(*hit, dir, medium);
+            ray = Ray{Scene::offsetOrigin(*hit, dir), dir};
+            segmentStart = 0.0f;
+            if (!roulette()) return;
+        }
+    }
+
+private:
+    const Scene& scene_;
+    const LightTracingSettings& settings_;
+};
+
+}  // namespace
+
+VrlSet traceVrls(const Scene& scene, const LightTracingSettings& settings,
+                 const std::function<void(double fraction)>& progress) {
+    if (settings.lightPaths == 0 && settings.targetVrls == 0)
+        throw std::invalid_argument("light tracing needs a number of light paths or a target number of VRLs");
+    const auto start = std::chrono::steady_clock::now();
+    const LightPathTracer tracer(scene, settings);
+    VrlSet result;
+    std::vector<std::vector<Vrl>> chunks(kChunksPerBatch);
+    uint64_t emptyBatches = 0;
+    while (true) {
+        const uint64_t remaining = settings.lightPaths > 0 ? settings.lightPaths - result.lightPaths : ~0ULL;
+        const uint64_t batch = std::min(remaining, kPathsPerChunk * kChunksPerBatch);
+        if (batch == 0) break;
+        const uint64_t first = result.lightPaths;
+        tbb::parallel_for(uint64_t(0), kChunksPerBatch, [&](uint64_t c) {
+            chunks[c].clear();
+            const uint64_t begin = std::min(batch, c * kPathsPerChunk), end = std::min(batch, (c + 1) * kPathsPerChunk);
+            for (uint64_t i = begin; i < end; ++i) tracer.trace(first + i, chunks[c]);
+        });
+        const size_t before = result.vrls.size();
+        for (const auto& chunk : chunks) result.vrls.insert(result.vrls.end(), chunk.begin(), chunk.end());
+        result.lightPaths += batch;
+        if (settings.lightPaths > 0) {
+            if (progress) progress(double(result.lightPaths) / double(settings.lightPaths));
+            continue;
+        }
+        if (progress) progress(std::min(1.0, double(result.vrls.size()) / double(settings.targetVrls)));
+        if (result.vrls.size() >= settings.targetVrls) break;
+        emptyBatches = result.vrls.size() == before ? emptyBatches + 1 : 0;
+        if (emptyBatches >= 16) {
+            spdlog::warn("light tracing: {} light paths deposited no VRL (no scattering medium reached); stopping",
+                         result.lightPaths);
+            break;
+        }
+    }
+    const float scale = result.lightPaths > 0 ? 1.0f / float(result.lightPaths) : 0.0f;
+    for (auto& v : result.vrls) v.flux *= scale;
+    result.vrls.shrink_to_fit();
+    result.tracingSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    return result;
+}
+
+}  // namespace vrl

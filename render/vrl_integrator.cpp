@@ -1,0 +1,86 @@
+#include "render/vrl_integrator.h"
+
+#include <cmath>
+
+namespace vrl {
+
+VrlIntegrator::VrlIntegrator(const Scene& scene, const VrlSet& vrls, const VrlIntegratorSettings& settings)
+    : scene_(scene),
+      vrls_(vrls),
+      settings_(settings),
+      tracer_(scene, PathTracerSettings{settings.maxDepth}),
+      estimator_(scene, settings.vrlSamples) {}
+
+std::array<Rgb, 4> VrlIntegrator::samplePathParts(const Ray& cameraRay, Rng& rng) const {
+    std::array<Rgb, 4> parts{Rgb(0.0f), Rgb(0.0f), Rgb(0.0f), Rgb(0.0f)};
+    if (settings_.transports.has(TransportPart::Surface))
+        parts[size_t(TransportPart::Surface)] =
+            tracer_.radiance(cameraRay, scene_.cameraMedium(), rng, PathStart{0, true, true});
+    const bool single = settings_.transports.has(TransportPart::Single);
+    const bool mediumSurface = settings_.transports.has(TransportPart::MediumSurface);
+    if (!single && !mediumSurface) return parts;
+    for (const CameraSegment& segment : cameraSegments(scene_, cameraRay, scene_.cameraMedium())) {
+        if (scene_.media()[segment.medium].isNonScattering()) continue;
+        if (single) parts[size_t(TransportPart::Single)] += singleScattering(segment, rng);
+        if (mediumSurface) parts[size_t(TransportPart::MediumSurface)] += mediumToSurface(segment, rng);
+    }
+    return parts;
+}
+
+Rgb VrlIntegrator::singleScattering(const CameraSegment& segment, Rng& rng) const {
+    if (settings_.maxDepth >= 0 && settings_.maxDepth < 2) return Rgb(0.0f);
+    const EmitterSampler& sampler = scene_.emitterSampler();
+    if (sampler.empty()) return Rgb(0.0f);
+    const auto [index, probability] = sampler.sample(rng.next());
+    const Emitter& emitter = *scene_.emitters()[index];
+    // Equiangular towards a point of the light (its position, or a random point of an area light).
+    const Vec3 towards = emitter.sampleDirect(segment.origin, Vec2(rng.next(), rng.next())).position;
+    const DistanceSample us = sampleEquiangular(segment.origin, segment.direction, segment.length, towards, rng.next());
+    if (!(us.pdf > 0.0f)) return Rgb(0.0f);
+    const Vec3 x = segment.origin + segment.direction * us.t;
+    const DirectLightSample light = emitter.sampleDirect(x, Vec2(rng.next(), rng.next()));
+    if (isBlack(light.weight)) return Rgb(0.0f);
+    const Rgb toLight = scene_.transmittance(x, light.position, segment.medium);
+    if (isBlack(toLight)) return Rgb(0.0f);
+    const HomogeneousMedium& medium = scene_.media()[segment.medium];
+    const float phase = medium.phase().eval(-light.direction, -segment.direction);
+    return segment.transmittanceBefore * medium.transmittance(us.t) * medium.sigmaS() * light.weight * toLight *
+           (phase / (probability * us.pdf));
+}
+
+Rgb VrlIntegrator::mediumToSurface(const CameraSegment& segment, Rng& rng) const {
+    if (settings_.maxDepth >= 0 && settings_.maxDepth < 3) return Rgb(0.0f);
+    const HomogeneousMedium& medium = scene_.media()[segment.medium];
+    // u in proportion to exp(-sigma u) on [0, length], sigma the mean extinction.
+    const double sigma = average(medium.sigmaT()), length = segment.length;
+    const double xi = rng.next();
+    double u, pdf;
+    if (sigma * length < 1e-6) {
+        u = xi * length;
+        pdf = 1.0 / length;
+    } else {
+        const double mass = -std::expm1(-sigma * length);
+        u = std::min(length, -std::log1p(-xi * mass) / sigma);
+        pdf = sigma * std::exp(-sigma * u) / mass;
+    }
+    if (!(pdf > 0.0)) return Rgb(0.0f);
+    const Vec3 x = segment.origin + segment.direction * float(u);
+    const PhaseSample next = medium.phase().sample(segment.direction, Vec2(rng.next(), rng.next()));
+    // Exact transmittance to the next surface, reflected light only: a path that
+    // scatters again in the medium first belongs to (d), emission at the surface to (b).
+    const Rgb reflected = tracer_.radiance(Ray{x, next.direction}, segment.medium, rng, PathStart{1, true, false});
+    return segment.transmittanceBefore * medium.transmittance(float(u)) * medium.sigmaS() * reflected *
+           float(1.0 / pdf);
+}
+
+Rgb VrlIntegrator::multipleScattering(const Ray& cameraRay, Rng& rng) const {
+    Rgb sum(0.0f);
+    if (!settings_.transports.has(TransportPart::Multiple)) return sum;
+    for (const CameraSegment& segment : cameraSegments(scene_, cameraRay, scene_.cameraMedium())) {
+        if (scene_.media()[segment.medium].isNonScattering()) continue;
+        for (const Vrl& v : vrls_.vrls) sum += estimator_.contribution(v, segment, rng);
+    }
+    return sum;
+}
+
+}  // namespace vrl

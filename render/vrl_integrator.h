@@ -1,0 +1,48 @@
+// VrlIntegrator: the image as the sum of four transport parts (transport.h).
+// (a) path-traces from the first surface the camera ray reaches, with the
+// camera segment's exact transmittance; (b) samples a point on the camera
+// segment equiangularly towards a light and does next-event estimation there;
+// (c) samples a point on the segment in proportion to transmittance, a
+// direction by the phase function, and path-traces from the surface that
+// direction reaches (exact transmittance in between, no emission there: (b)
+// has it); (d) sums the VRL estimator over every VRL (plain VRLs, --method vrl).
+// Each part is estimated for paths its siblings leave out, so the parts add up
+// to the reference path tracer's image.
+#pragma once
+
+#include "render/path_tracer.h"
+#include "render/transport.h"
+#include "render/vrl.h"
+#include "render/vrl_estimator.h"
+
+#include <array>
+
+namespace vrl {
+
+struct VrlIntegratorSettings {
+    TransportSelection transports;
+    int maxDepth = -1;
+    int vrlSamples = 1;  // (u, v) samples per VRL and camera segment
+};
+
+class VrlIntegrator {
+public:
+    VrlIntegrator(const Scene& scene, const VrlSet& vrls, const VrlIntegratorSettings& settings);
+
+    // Parts (a), (b), (c) for one camera ray: one sample each.
+    std::array<Rgb, 4> samplePathParts(const Ray& cameraRay, Rng& rng) const;
+    // Part (d) for one camera ray: every VRL against every camera segment.
+    Rgb multipleScattering(const Ray& cameraRay, Rng& rng) const;
+
+private:
+    Rgb singleScattering(const CameraSegment& segment, Rng& rng) const;
+    Rgb mediumToSurface(const CameraSegment& segment, Rng& rng) const;
+
+    const Scene& scene_;
+    const VrlSet& vrls_;
+    VrlIntegratorSettings settings_;
+    VolumetricPathTracer tracer_;
+    VrlEstimator estimator_;
+};
+
+}  // namespace vrl
