@@ -21,7 +21,7 @@ std::vector<CameraSegment> cameraSegments(const Scene& scene, const Ray& cameraR
         if (!hit || !scene.shapes()[hit->shape].bsdf.isNull()) break;
         medium = scene.mediumAfter(*hit, ray.direction, medium);
         segmentStart = hit->t;
-        ray.tMin = Scene::tMinPast(ray, *hit);
+        Scene::continuePast(ray, *hit);
     }
     if (transmittanceToEnd) *transmittanceToEnd = transmittance;
     return segments;

@@ -5,6 +5,7 @@
 #include <Imath/ImathVec.h>
 
 #include <cmath>
+#include <cstdint>
 #include <limits>
 
 namespace vrl {
@@ -25,6 +26,11 @@ struct Ray {
     Vec3 direction;
     float tMax = kInfinity;
     float tMin = 0.0f;
+    // Hits on shape `skipShape` closer than `skipUntil` are ignored: the surface the
+    // ray just crossed. Any other surface at the same distance is still found.
+    static constexpr uint32_t kNoShape = ~0u;
+    uint32_t skipShape = kNoShape;
+    float skipUntil = 0.0f;
 
     Vec3 at(float t) const { return origin + direction * t; }
 };

@@ -99,7 +99,7 @@ public:
             if (shape.bsdf.isNull()) {
                 medium = scene_.mediumAfter(*hit, ray.direction, medium);
                 segmentStart = hit->t;
-                ray.tMin = Scene::tMinPast(ray, *hit);
+                Scene::continuePast(ray, *hit);
                 continue;
             }
             // Diffuse bounce about the geometric normal: the cosine-sampled weight is

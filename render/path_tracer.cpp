@@ -83,7 +83,7 @@ Rgb VolumetricPathTracer::radiance(Ray ray, int medium, Rng& rng, const PathStar
         if (shape.bsdf.isNull()) {
             medium = scene_.mediumAfter(*hit, ray.direction, medium);
             segmentStart = hit->t;
-            ray.tMin = Scene::tMinPast(ray, *hit);  // same ray: distances stay exact
+            Scene::continuePast(ray, *hit);  // same ray: distances stay exact
             continue;
         }
         firstSegment = false;

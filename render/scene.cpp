@@ -26,6 +26,23 @@ struct Scene::Embree {
 
 namespace {
 
+// Embree context carrying the shape a continued ray must ignore (Ray::skipShape).
+struct SkipContext {
+    RTCIntersectContext context;
+    uint32_t skipShape;
+    float skipUntil;
+};
+
+void skipCrossedShape(const RTCFilterFunctionNArguments* args) {
+    const auto* skip = reinterpret_cast<const SkipContext*>(args->context);
+    for (unsigned i = 0; i < args->N; ++i) {
+        if (args->valid[i] == 0) continue;
+        if (RTCHitN_geomID(args->hit, args->N, i) == skip->skipShape &&
+            RTCRayN_tfar(args->ray, args->N, i) < skip->skipUntil)
+            args->valid[i] = 0;
+    }
+}
+
 void embreeErrorCallback(void* userData, RTCError code, const char* message) {
     auto* embree = static_cast<std::string*>(userData);
     spdlog::error("Embree error {}: {}", int(code), message ? message : "");
@@ -181,6 +198,7 @@ void Scene::buildBvh() {
     if (!embree_->device) throw std::runtime_error("cannot create the Embree device (error " + std::to_string(int(rtcGetDeviceError(nullptr))) + ")");
     rtcSetDeviceErrorFunction(embree_->device, embreeErrorCallback, &embree_->firstError);
     embree_->scene = rtcNewScene(embree_->device);
+    rtcSetSceneFlags(embree_->scene, RTC_SCENE_FLAG_CONTEXT_FILTER_FUNCTION);
     rtcSetSceneBuildQuality(embree_->scene, RTC_BUILD_QUALITY_HIGH);
     for (size_t i = 0; i < shapes_.size(); ++i) {
         const TriangleMesh& mesh = shapes_[i].mesh;
@@ -209,8 +227,13 @@ void Scene::buildBvh() {
 
 std::optional<SurfaceHit> Scene::intersect(const Ray& ray) const {
     if (shapes_.empty()) return std::nullopt;
-    RTCIntersectContext context;
-    rtcInitIntersectContext(&context);
+    SkipContext skip{};
+    rtcInitIntersectContext(&skip.context);
+    if (ray.skipShape != Ray::kNoShape) {
+        skip.context.filter = skipCrossedShape;
+        skip.skipShape = ray.skipShape;
+        skip.skipUntil = ray.skipUntil;
+    }
     RTCRayHit rayHit{};
     rayHit.ray.org_x = ray.origin.x;
     rayHit.ray.org_y = ray.origin.y;
@@ -222,7 +245,7 @@ std::optional<SurfaceHit> Scene::intersect(const Ray& ray) const {
     rayHit.ray.tfar = ray.tMax;
     rayHit.ray.mask = ~0u;
     rayHit.hit.geomID = RTC_INVALID_GEOMETRY_ID;
-    rtcIntersect1(embree_->scene, &context, &rayHit);
+    rtcIntersect1(embree_->scene, &skip.context, &rayHit);
     if (rayHit.hit.geomID == RTC_INVALID_GEOMETRY_ID) return std::nullopt;
     SurfaceHit hit;
     hit.t = rayHit.ray.tfar;
@@ -263,11 +286,18 @@ Vec3 Scene::offsetOrigin(const SurfaceHit& hit, const Vec3& direction) {
     return p + hit.geometricNormal * (side * 1e-4f * scale);
 }
 
-float Scene::tMinPast(const Ray& ray, const SurfaceHit& hit) {
+void Scene::continuePast(Ray& ray, const SurfaceHit& hit) {
     const Vec3& p = hit.position;
     const float scale = 1.0f + std::max({std::abs(p.x), std::abs(p.y), std::abs(p.z)});
     const float cosine = std::max(std::abs(ray.direction.dot(hit.geometricNormal)), 1e-3f);
-    return hit.t + 1e-4f * scale / cosine;
+    // Float noise around the crossing: a surface coinciding with the one crossed
+    // (an opaque wall flush with a medium's boundary) is still found, and the
+    // crossed shape is ignored until past it (a hit on a shared edge reports both
+    // of its triangles).
+    const float noise = 1e-5f * scale / cosine;
+    ray.tMin = std::max(0.0f, hit.t - noise);
+    ray.skipShape = hit.shape;
+    ray.skipUntil = hit.t + noise;
 }
 
 int Scene::mediumAfter(const SurfaceHit& hit, const Vec3& direction, int currentMedium) const {
@@ -297,8 +327,7 @@ Rgb Scene::transmittance(const Vec3& from, const Vec3& to, int medium) const {
         if (!shapes_[hit->shape].bsdf.isNull()) return Rgb(0.0f);
         medium = mediumAfter(*hit, ray.direction, medium);
         segmentStart = hit->t;
-        ray.tMin = tMinPast(ray, *hit);
-        if (ray.tMin >= ray.tMax) return result;
+        continuePast(ray, *hit);
     }
     return Rgb(0.0f);
 }

@@ -70,8 +70,9 @@ public:
 
     // Origin for a ray leaving a surface point in `direction` (offset against self-hits).
     static Vec3 offsetOrigin(const SurfaceHit& hit, const Vec3& direction);
-    // tMin that continues `ray` past the surface it hit at `hit` (crossing a null boundary).
-    static float tMinPast(const Ray& ray, const SurfaceHit& hit);
+    // Continues `ray` past the surface it hit at `hit` (crossing a null boundary):
+    // the same ray from the hit distance on, ignoring only that shape there.
+    static void continuePast(Ray& ray, const SurfaceHit& hit);
 
 private:
     Scene(const SceneDescription& description);

@@ -293,5 +293,42 @@ TEST(SceneTest, DefaultBsdfFollowsMitsuba) {
     EXPECT_TRUE(scene->hasNullSurfaces());
 }
 
+
+// A medium's null boundary flush with (or a hair inside) an opaque room: shadow
+// rays crossing the boundary must still stop at the wall, whatever the shape order.
+TEST(SceneTest, OpaqueWallFlushWithNullBoundaryStillBlocks) {
+    for (int order = 0; order < 2; ++order) {
+        for (float wall : {1.0f, 1.00001f, 1.0001f, 1.001f}) {
+            SceneDescription d;
+            d.sensor = test::cameraAtOrigin(4, 4, 45.0f);
+            MediumDescription m;
+            m.id = "fog";
+            m.sigmaS = Rgb(0.0f);
+            m.sigmaA = Rgb(0.5f);
+            d.media.push_back(m);
+            ShapeDescription box;
+            box.kind = ShapeDescription::Kind::Cube;
+            box.bsdf = BsdfDescription{BsdfDescription::Kind::Null, Rgb(0.0f), false};
+            box.interiorMedium = 0;
+            ShapeDescription room;
+            room.kind = ShapeDescription::Kind::Cube;
+            room.flipNormals = true;
+            room.toWorld = Transform::scale(Vec3(wall));
+            if (order == 0) {
+                d.shapes = {box, room};
+            } else {
+                d.shapes = {room, box};
+            }
+            const auto scene = Scene::build(d);
+            for (int i = 0; i < 200; ++i) {
+                const float a = 0.031f * i;
+                const Vec3 from(0.1f * std::sin(a), 0.2f * std::cos(a), 0.05f);
+                const Vec3 to(3.0f, 0.5f * std::sin(3 * a), 0.7f * std::cos(2 * a));
+                ASSERT_EQ(scene->transmittance(from, to, 0), Rgb(0.0f)) << "order " << order << " wall " << wall << " ray " << i;
+            }
+        }
+    }
+}
+
 }  // namespace
 }  // namespace vrl
