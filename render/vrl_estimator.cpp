@@ -114,26 +114,34 @@ Rgb VrlEstimator::sampleOnce(const Vrl& vrl, const CameraSegment& segment, Rng& 
     const Vec3 xv = vrl.origin + vrl.direction * vs.t;
 
     // u | v: equiangular from xv, or for anisotropic media a mixture of that with a
-    // piecewise-constant fit of f(u) f(v) over 16 bins of the equiangular angle.
+    // piecewise-constant fit of f(u) f(v) over kBins bins of the equiangular angle.
     const Equiangular e = equiangular(segment.origin, segment.direction, segment.length, xv);
     const double span = e.thetaB - e.thetaA;
     if (!(span > 0.0)) return Rgb(0.0f);
     const bool anisotropic = !mediumU.phase().isIsotropic() || !mediumV.phase().isIsotropic();
-    constexpr int kBins = 16;
+    constexpr int kBins = 8;
     constexpr double kUniformWeight = 0.25;
     std::array<double, kBins> binWeight{};
     double binTotal = 0.0;
-    const auto phaseProduct = [&](double theta) {
-        const double u = e.delta + e.h * std::tan(theta);
-        const Vec3 xu = segment.origin + segment.direction * float(u);
-        const Vec3 toU = (xu - xv).normalized();
-        return double(mediumV.phase().eval(vrl.direction, toU) * mediumU.phase().eval(toU, -segment.direction));
-    };
     double theta;
     if (anisotropic) {
+        // In the plane of the camera line and xv, the direction from xv to u(theta) is
+        // w sin(theta) - e cos(theta), e the unit offset of xv from the line: so
+        // cos to the VRL = sin(theta) (d.w) - cos(theta) (d.e), cos to the camera = -sin(theta).
+        const Vec3 foot = segment.origin + segment.direction * float(e.delta);
+        const Vec3 offset = xv - foot;
+        const float offsetLength = offset.length();
+        const Vec3 unitOffset = offsetLength > 0.0f ? offset / offsetLength : Frame::fromNormal(segment.direction).s;
+        const double dw = vrl.direction.dot(segment.direction), de = vrl.direction.dot(unitOffset);
+        const double step = span / kBins;
+        double c = std::cos(e.thetaA + 0.5 * step), s = std::sin(e.thetaA + 0.5 * step);
+        const double cStep = std::cos(step), sStep = std::sin(step);
         for (int b = 0; b < kBins; ++b) {
-            binWeight[b] = phaseProduct(e.thetaA + (b + 0.5) * span / kBins);
+            binWeight[b] = double(mediumV.phase().evalCosine(float(s * dw - c * de)) * mediumU.phase().evalCosine(float(-s)));
             binTotal += binWeight[b];
+            const double cNext = c * cStep - s * sStep;
+            s = s * cStep + c * sStep;
+            c = cNext;
         }
     }
     if (anisotropic && binTotal > 0.0 && rng.next() >= kUniformWeight) {

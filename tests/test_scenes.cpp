@@ -76,6 +76,69 @@ SceneDescription pointLightInInfiniteMedium(const Rgb& intensity, const Vec3& li
     return scene;
 }
 
+SceneDescription mediumOnlyCube(const Rgb& sigmaS, const Rgb& sigmaA, float g) {
+    SceneDescription scene;
+    scene.sensor = cameraAtOrigin(16, 16, 40.0f);
+    scene.sensor.toWorld = Transform::lookAt(Vec3(0.3f, 0.2f, -3.5f), Vec3(0, 0, 0), Vec3(0, 1, 0));
+    MediumDescription medium;
+    medium.id = "cube";
+    medium.sigmaS = sigmaS;
+    medium.sigmaA = sigmaA;
+    if (g != 0.0f) medium.phase = {PhaseDescription::Kind::HenyeyGreenstein, g};
+    scene.media.push_back(medium);
+    ShapeDescription cube;
+    cube.kind = ShapeDescription::Kind::Cube;
+    cube.bsdf = BsdfDescription{BsdfDescription::Kind::Null, Rgb(0.0f), false};
+    cube.interiorMedium = 0;
+    scene.shapes.push_back(cube);
+    EmitterDescription light;
+    light.kind = EmitterDescription::Kind::Point;
+    light.intensity = Rgb(3.0f);
+    light.toWorld = Transform::translate(Vec3(0.2f, 0.5f, 0.3f));
+    light.medium = 0;
+    scene.emitters.push_back(light);
+    return scene;
+}
+
+SceneDescription litRoomWithOccluder(const Rgb& sigmaS, const Rgb& sigmaA, float g) {
+    SceneDescription scene;
+    scene.sensor = cameraAtOrigin(16, 16, 75.0f);
+    scene.sensor.toWorld = Transform::lookAt(Vec3(0.2f, 0.3f, -1.9f), Vec3(0, -0.4f, 1), Vec3(0, 1, 0));
+    MediumDescription medium;
+    medium.id = "smoke";
+    medium.sigmaS = sigmaS;
+    medium.sigmaA = sigmaA;
+    if (g != 0.0f) medium.phase = {PhaseDescription::Kind::HenyeyGreenstein, g};
+    scene.media.push_back(medium);
+    scene.sensor.medium = 0;
+    ShapeDescription room;
+    room.kind = ShapeDescription::Kind::Cube;
+    room.toWorld = Transform::scale(Vec3(2.0f));
+    room.bsdf = BsdfDescription{BsdfDescription::Kind::Diffuse, Rgb(0.6f, 0.55f, 0.5f), true};
+    scene.shapes.push_back(room);
+    ShapeDescription occluder;
+    occluder.kind = ShapeDescription::Kind::Cube;
+    occluder.toWorld = Transform::scale(Vec3(0.5f, 0.8f, 0.5f)).then(Transform::rotate(Vec3(0, 1, 0), 25.0f)).then(
+        Transform::translate(Vec3(0.4f, -1.2f, 0.6f)));
+    occluder.bsdf = BsdfDescription{BsdfDescription::Kind::Diffuse, Rgb(0.3f, 0.5f, 0.7f), false};
+    scene.shapes.push_back(occluder);
+    ShapeDescription panel;
+    panel.kind = ShapeDescription::Kind::Rectangle;
+    panel.toWorld = Transform::scale(Vec3(0.4f)).then(Transform::rotate(Vec3(1, 0, 0), 90.0f)).then(
+        Transform::translate(Vec3(-0.8f, 1.95f, 0.8f)));  // +z rotated to -y: faces the floor
+    panel.areaRadiance = Rgb(6.0f, 5.0f, 4.0f);
+    panel.bsdf = BsdfDescription{BsdfDescription::Kind::Diffuse, Rgb(0.0f), false};
+    scene.shapes.push_back(panel);
+    EmitterDescription spot;
+    spot.kind = EmitterDescription::Kind::Spot;
+    spot.intensity = Rgb(12.0f);
+    spot.cutoffAngle = 35.0f;
+    spot.beamWidth = 25.0f;
+    spot.toWorld = Transform::lookAt(Vec3(1.2f, 1.6f, -0.5f), Vec3(0.2f, -2.0f, 0.8f), Vec3(0, 0, 1));
+    scene.emitters.push_back(spot);
+    return scene;
+}
+
 SceneDescription smallSmokeRoom() {
     SceneDescription scene;
     scene.sensor = cameraAtOrigin(24, 16, 70.0f);

@@ -24,6 +24,15 @@ SceneDescription absorberSlab(const Rgb& radiance, const Rgb& sigmaA, float thic
 SceneDescription pointLightInInfiniteMedium(const Rgb& intensity, const Vec3& lightPosition, const Rgb& sigmaS,
                                            const Rgb& sigmaA, float g);
 
+// Medium only: a null-bounded cube [-1,1]^3 of medium (sigmaS, sigmaA, HG g)
+// seen from outside (camera in vacuum at z = -3.5), lit by a point light inside it.
+SceneDescription mediumOnlyCube(const Rgb& sigmaS, const Rgb& sigmaA, float g);
+
+// Surfaces: a closed room (two-sided diffuse box [-2,2]^3) filled with a medium,
+// an opaque diffuse occluder box inside, a spot light and an area light (a
+// rectangle under the ceiling facing down). Flat geometry only.
+SceneDescription litRoomWithOccluder(const Rgb& sigmaS, const Rgb& sigmaA, float g);
+
 // A closed room (cube of half-size 2) with two-sided diffuse walls, a diffuse
 // sphere, a spot light and a scene-filling medium: a little of everything.
 SceneDescription smallSmokeRoom();
