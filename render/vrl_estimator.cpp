@@ -64,8 +64,9 @@ DistanceSample sampleVrlPoint(const Vrl& vrl, const Vec3& lineOrigin, const Vec3
     if (p.parallel) return {xi * vrl.length, 1.0f / vrl.length};
     const AsinhRange a = asinhRange(p, vrl.length);
     if (!(a.a1 > a.a0)) return {xi * vrl.length, 1.0f / vrl.length};
-    double v = p.v0 + a.h / p.sinTheta * std::sinh(a.a0 + xi * (a.a1 - a.a0));
-    v = std::clamp(v, 0.0, double(vrl.length));
+    // Round to the float returned first, so the pdf is that of the point returned.
+    const double v = double(std::clamp(float(p.v0 + a.h / p.sinTheta * std::sinh(a.a0 + xi * (a.a1 - a.a0))), 0.0f,
+                                       vrl.length));
     const double pdf = p.sinTheta / ((a.a1 - a.a0) * std::sqrt(a.h * a.h + p.sinTheta * p.sinTheta * (v - p.v0) * (v - p.v0)));
     return {float(v), float(pdf)};
 }
@@ -84,7 +85,8 @@ DistanceSample sampleEquiangular(const Vec3& origin, const Vec3& direction, floa
     if (!(length > 0.0f)) return {};
     const Equiangular e = equiangular(origin, direction, length, point);
     if (!(e.thetaB > e.thetaA)) return {xi * length, 1.0f / length};
-    const double u = std::clamp(e.delta + e.h * std::tan(e.thetaA + xi * (e.thetaB - e.thetaA)), 0.0, double(length));
+    const double u =
+        double(std::clamp(float(e.delta + e.h * std::tan(e.thetaA + xi * (e.thetaB - e.thetaA))), 0.0f, length));
     const double pdf = e.h / ((e.thetaB - e.thetaA) * (e.h * e.h + (u - e.delta) * (u - e.delta)));
     return {float(u), float(pdf)};
 }
@@ -158,7 +160,7 @@ Rgb VrlEstimator::sampleOnce(const Vrl& vrl, const CameraSegment& segment, Rng& 
         const int b = std::min(kBins - 1, int((theta - e.thetaA) / span * kBins));
         thetaPdf = kUniformWeight / span + (1.0 - kUniformWeight) * binWeight[b] / binTotal * kBins / span;
     }
-    const double u = std::clamp(e.delta + e.h * std::tan(theta), 0.0, double(segment.length));
+    const double u = double(std::clamp(float(e.delta + e.h * std::tan(theta)), 0.0f, segment.length));
     const double uPdf = thetaPdf * e.h / (e.h * e.h + (u - e.delta) * (u - e.delta));
 
     const Vec3 xu = segment.origin + segment.direction * float(u);

@@ -57,6 +57,21 @@ TEST(RendererDeterminism, DifferentSeedsGiveDifferentImages) {
     EXPECT_FALSE(bitIdentical(a, b));
 }
 
+TEST(RendererDeterminism, VrlMethodSameImageWithOneAndTwoThreads) {
+    const auto scene = Scene::build(test::smallSmokeRoom());
+    RenderSettings settings;
+    settings.method = "vrl";
+    settings.samplesPerPixel = 2;
+    settings.vrlCount = 2000;
+    settings.seed = 17;
+    settings.tileSize = 5;
+    const Image one = renderWithThreads(*scene, settings, 1);
+    EXPECT_TRUE(bitIdentical(one, renderWithThreads(*scene, settings, 2)));
+    double total = 0;
+    for (const auto& p : one.pixels()) total += luminance(p);
+    EXPECT_GT(total, 0.0);
+}
+
 TEST(Renderer, RejectsUnknownMethodAndZeroSamples) {
     const auto scene = Scene::build(test::smallSmokeRoom());
     RenderSettings settings;

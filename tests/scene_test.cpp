@@ -330,5 +330,22 @@ TEST(SceneTest, OpaqueWallFlushWithNullBoundaryStillBlocks) {
     }
 }
 
+// VRL shading skips occlusion rays only where nothing can block a segment.
+TEST(SceneTest, MediumNeedsVisibilityOnlyWhenSomethingCanOcclude) {
+    EXPECT_FALSE(Scene::build(test::mediumOnlyCube(Rgb(0.5f), Rgb(0.1f), 0.0f))->mediumNeedsVisibility(0));
+    EXPECT_FALSE(Scene::build(test::pointLightInInfiniteMedium(Rgb(1.0f), Vec3(0.0f), Rgb(0.5f), Rgb(0.1f), 0.0f))
+                     ->mediumNeedsVisibility(0));
+    EXPECT_TRUE(Scene::build(test::litRoomWithOccluder(Rgb(0.5f), Rgb(0.1f), 0.0f))->mediumNeedsVisibility(0));
+    // A convex medium box with an opaque object inside it needs visibility too.
+    SceneDescription d = test::mediumOnlyCube(Rgb(0.5f), Rgb(0.1f), 0.0f);
+    ShapeDescription inside;
+    inside.kind = ShapeDescription::Kind::Cube;
+    inside.toWorld = Transform::scale(Vec3(0.2f));
+    inside.exteriorMedium = 0;
+    inside.bsdf = BsdfDescription{};
+    d.shapes.push_back(inside);
+    EXPECT_TRUE(Scene::build(d)->mediumNeedsVisibility(0));
+}
+
 }  // namespace
 }  // namespace vrl

@@ -85,10 +85,10 @@ void expectAgree(const RunStatistics& vrl, const RunStatistics& reference, const
     EXPECT_LT(vrl.standardError[image][1], 0.05f * reference.mean[image][1]) << what << ": too noisy to mean much";
 }
 
-RunStatistics referenceRuns(const Scene& scene, int spp, bool onlyMediumToMedium) {
+RunStatistics referenceRuns(const Scene& scene, int spp, bool onlyMediumToMedium, int maxDepth = -1) {
     return overRuns([&](uint64_t seed) {
         Image image(scene.camera().width(), scene.camera().height());
-        const VolumetricPathTracer tracer(scene, PathTracerSettings{-1, 5, onlyMediumToMedium});
+        const VolumetricPathTracer tracer(scene, PathTracerSettings{maxDepth, 5, onlyMediumToMedium});
         tbb::parallel_for(0, image.height(), [&](int y) {
             for (int x = 0; x < image.width(); ++x) {
                 Rng rng(seed * 7919, uint64_t(y * image.width() + x));
@@ -102,7 +102,7 @@ RunStatistics referenceRuns(const Scene& scene, int spp, bool onlyMediumToMedium
     });
 }
 
-RunStatistics vrlRuns(const Scene& scene, const std::string& transports, int spp, uint64_t vrls) {
+RunStatistics vrlRuns(const Scene& scene, const std::string& transports, int spp, uint64_t vrls, int maxDepth = -1) {
     return overRuns([&](uint64_t seed) {
         RenderSettings settings;
         settings.method = "vrl";
@@ -110,6 +110,7 @@ RunStatistics vrlRuns(const Scene& scene, const std::string& transports, int spp
         settings.samplesPerPixel = spp;
         settings.vrlCount = vrls;
         settings.seed = seed;
+        settings.maxDepth = maxDepth;
         return render(scene, settings).image;
     });
 }
@@ -144,6 +145,17 @@ TEST(VrlImage, MultipleScatteringEqualsRestrictedReference) {
     for (const MediumCase& m : kMedia) {
         const auto scene = Scene::build(test::litRoomWithOccluder(m.sigmaS * 0.5f, m.sigmaA * 0.5f, m.g));
         expectAgree(vrlRuns(*scene, "multiple", 1, kVrls), referenceRuns(*scene, kReferenceSpp, true), m.name);
+    }
+}
+
+// maxDepth bookkeeping of every part: 3 allows double scattering and one bounce
+// after a medium vertex; 4 one more.
+TEST(VrlImage, PartsSumToReferenceWithDepthLimit) {
+    const auto scene = Scene::build(test::litRoomWithOccluder(Rgb(0.4f), Rgb(0.1f), 0.0f));
+    for (int depth : {2, 3, 4}) {
+        const std::string what = "maxDepth " + std::to_string(depth);
+        expectAgree(vrlRuns(*scene, "surface,single,medium-surface,multiple", 16, kVrls, depth),
+                    referenceRuns(*scene, kReferenceSpp / 2, false, depth), what.c_str());
     }
 }
 
