@@ -2,6 +2,17 @@
 
 namespace vrl::test {
 
+namespace {
+MediumDescription medium(const std::string& id, const Rgb& sigmaS, const Rgb& sigmaA, float g) {
+    MediumDescription m;
+    m.id = id;
+    m.sigmaS = sigmaS;
+    m.sigmaA = sigmaA;
+    if (g != 0.0f) m.phase = {PhaseDescription::Kind::HenyeyGreenstein, g};
+    return m;
+}
+}  // namespace
+
 SensorDescription cameraAtOrigin(int width, int height, float fovDegrees) {
     SensorDescription sensor;
     sensor.toWorld = Transform::lookAt(Vec3(0, 0, 0), Vec3(0, 0, 1), Vec3(0, 1, 0));
@@ -15,12 +26,7 @@ SensorDescription cameraAtOrigin(int width, int height, float fovDegrees) {
 SceneDescription emittingSphereFurnace(const Rgb& radiance, const Rgb& sigmaS, float g) {
     SceneDescription scene;
     scene.sensor = cameraAtOrigin(8, 8, 90.0f);
-    MediumDescription medium;
-    medium.id = "furnace";
-    medium.sigmaS = sigmaS;
-    medium.sigmaA = Rgb(0.0f);
-    if (g != 0.0f) medium.phase = {PhaseDescription::Kind::HenyeyGreenstein, g};
-    scene.media.push_back(medium);
+    scene.media.push_back(medium("furnace", sigmaS, Rgb(0.0f), g));
     scene.sensor.medium = 0;
     ShapeDescription sphere;
     sphere.kind = ShapeDescription::Kind::Sphere;
@@ -36,11 +42,7 @@ SceneDescription emittingSphereFurnace(const Rgb& radiance, const Rgb& sigmaS, f
 SceneDescription absorberSlab(const Rgb& radiance, const Rgb& sigmaA, float thickness) {
     SceneDescription scene;
     scene.sensor = cameraAtOrigin(9, 9, 20.0f);
-    MediumDescription medium;
-    medium.id = "absorber";
-    medium.sigmaS = Rgb(0.0f);
-    medium.sigmaA = sigmaA;
-    scene.media.push_back(medium);
+    scene.media.push_back(medium("absorber", Rgb(0.0f), sigmaA, 0.0f));
     ShapeDescription slab;
     slab.kind = ShapeDescription::Kind::Cube;
     slab.toWorld = Transform::scale(Vec3(10.0f, 10.0f, 0.5f * thickness)).then(Transform::translate(Vec3(0, 0, 3)));
@@ -61,12 +63,7 @@ SceneDescription pointLightInInfiniteMedium(const Rgb& intensity, const Vec3& li
                                            const Rgb& sigmaA, float g) {
     SceneDescription scene;
     scene.sensor = cameraAtOrigin(4, 4, 60.0f);
-    MediumDescription medium;
-    medium.id = "fog";
-    medium.sigmaS = sigmaS;
-    medium.sigmaA = sigmaA;
-    if (g != 0.0f) medium.phase = {PhaseDescription::Kind::HenyeyGreenstein, g};
-    scene.media.push_back(medium);
+    scene.media.push_back(medium("fog", sigmaS, sigmaA, g));
     scene.sensor.medium = 0;
     EmitterDescription light;
     light.kind = EmitterDescription::Kind::Point;
@@ -80,12 +77,7 @@ SceneDescription mediumOnlyCube(const Rgb& sigmaS, const Rgb& sigmaA, float g) {
     SceneDescription scene;
     scene.sensor = cameraAtOrigin(16, 16, 40.0f);
     scene.sensor.toWorld = Transform::lookAt(Vec3(0.3f, 0.2f, -3.5f), Vec3(0, 0, 0), Vec3(0, 1, 0));
-    MediumDescription medium;
-    medium.id = "cube";
-    medium.sigmaS = sigmaS;
-    medium.sigmaA = sigmaA;
-    if (g != 0.0f) medium.phase = {PhaseDescription::Kind::HenyeyGreenstein, g};
-    scene.media.push_back(medium);
+    scene.media.push_back(medium("cube", sigmaS, sigmaA, g));
     ShapeDescription cube;
     cube.kind = ShapeDescription::Kind::Cube;
     cube.bsdf = BsdfDescription{BsdfDescription::Kind::Null, Rgb(0.0f), false};
@@ -104,12 +96,7 @@ SceneDescription litRoomWithOccluder(const Rgb& sigmaS, const Rgb& sigmaA, float
     SceneDescription scene;
     scene.sensor = cameraAtOrigin(16, 16, 75.0f);
     scene.sensor.toWorld = Transform::lookAt(Vec3(0.2f, 0.3f, -1.9f), Vec3(0, -0.4f, 1), Vec3(0, 1, 0));
-    MediumDescription medium;
-    medium.id = "smoke";
-    medium.sigmaS = sigmaS;
-    medium.sigmaA = sigmaA;
-    if (g != 0.0f) medium.phase = {PhaseDescription::Kind::HenyeyGreenstein, g};
-    scene.media.push_back(medium);
+    scene.media.push_back(medium("smoke", sigmaS, sigmaA, g));
     scene.sensor.medium = 0;
     ShapeDescription room;
     room.kind = ShapeDescription::Kind::Cube;
@@ -143,12 +130,7 @@ SceneDescription smallSmokeRoom() {
     SceneDescription scene;
     scene.sensor = cameraAtOrigin(24, 16, 70.0f);
     scene.sensor.toWorld = Transform::lookAt(Vec3(0, 0, -1.8f), Vec3(0, -0.3f, 1), Vec3(0, 1, 0));
-    MediumDescription smoke;
-    smoke.id = "smoke";
-    smoke.sigmaS = Rgb(0.3f, 0.35f, 0.4f);
-    smoke.sigmaA = Rgb(0.05f);
-    smoke.phase = {PhaseDescription::Kind::HenyeyGreenstein, 0.5f};
-    scene.media.push_back(smoke);
+    scene.media.push_back(medium("smoke", Rgb(0.3f, 0.35f, 0.4f), Rgb(0.05f), 0.5f));
     scene.sensor.medium = 0;
     ShapeDescription room;
     room.kind = ShapeDescription::Kind::Cube;
