@@ -38,6 +38,11 @@ struct RenderCommandOptions {
     uint64_t lightPaths = 0;
     int vrlSamples = 1;
     std::string transport = "surface,single,medium-surface,multiple";
+    float error = 0.02f;
+    uint32_t maxCut = 4096;
+    uint32_t exactDistanceBelow = 32;
+    float hgEpsilon = 1.0f;
+    uint32_t partitionSize = 2048;
 };
 
 double secondsSince(std::chrono::steady_clock::time_point start) {
@@ -95,6 +100,11 @@ int runRender(const RenderCommandOptions& o) {
     settings.vrlCount = o.vrls;
     settings.lightPaths = o.lightPaths;
     settings.vrlSamples = o.vrlSamples;
+    settings.cut.errorThreshold = o.error;
+    settings.cut.maxCutSize = o.maxCut;
+    settings.cut.bound.exactDistanceBelow = o.exactDistanceBelow;
+    settings.cut.bound.anisotropyEpsilon = o.hgEpsilon;
+    settings.partitionSize = o.partitionSize;
     const double parseSeconds = secondsSince(t0);
 
     t0 = Clock::now();
@@ -138,7 +148,15 @@ int runRender(const RenderCommandOptions& o) {
     images.metadata["vrl.time.parse"] = std::to_string(parseSeconds);
     images.metadata["vrl.time.build"] = std::to_string(buildSeconds);
     images.metadata["vrl.time.render"] = std::to_string(stats.seconds);
-    if (settings.method == "vrl") {
+    if (settings.method == "vrl-lightcuts") {
+        images.metadata["vrl.error"] = std::to_string(o.error);
+        images.metadata["vrl.maxCut"] = std::to_string(o.maxCut);
+        images.metadata["vrl.exactDistanceBelow"] = std::to_string(o.exactDistanceBelow);
+        images.metadata["vrl.hgEpsilon"] = std::to_string(o.hgEpsilon);
+        images.metadata["vrl.partitionSize"] = std::to_string(o.partitionSize);
+        images.metadata["vrl.time.treeBuild"] = std::to_string(stats.treeSeconds);
+    }
+    if (settings.method != "path") {
         images.metadata["vrl.transport"] = settings.transports.toString();
         images.metadata["vrl.vrlSamples"] = std::to_string(settings.vrlSamples);
         images.metadata["vrl.vrlCount"] = std::to_string(stats.vrlCount);
@@ -159,11 +177,16 @@ int runRender(const RenderCommandOptions& o) {
                  (unsigned long long)stats.cameraSamples,
                  stats.seconds > 0 ? double(stats.cameraSamples) / stats.seconds : 0.0, writeSeconds,
                  o.output.c_str(), peakMemoryMiB());
-    if (settings.method == "vrl") {
+    if (settings.method != "path") {
         std::fprintf(stderr, "  light tracing %.3f s: %llu light paths -> %llu VRLs, %.1f MiB (%zu bytes each)\n",
                      stats.tracingSeconds, (unsigned long long)stats.lightPaths, (unsigned long long)stats.vrlCount,
                      double(stats.vrlBytes) / (1024.0 * 1024.0), sizeof(Vrl));
         std::fprintf(stderr, "  transport parts: %s\n", settings.transports.toString().c_str());
+    }
+    if (settings.method == "vrl-lightcuts") {
+        std::fprintf(stderr, "  light tree %.3f s, %.1f MiB; per pixel: #Eval %.1f, #Inter %.1f, cut size %.1f\n",
+                     stats.treeSeconds, double(stats.treeBytes) / (1024.0 * 1024.0), stats.meanEvaluated,
+                     stats.meanIntersected, stats.meanCutSize);
     }
     return 0;
 }
@@ -177,8 +200,9 @@ void registerRenderCommand(CLI::App& app, int& exitCode) {
     cmd->add_option("-o,--output", o->output, "Output OpenEXR file")->required();
     cmd->add_option("-D,--define", o->defines, "Override a scene <default>: -D name=value (repeatable)");
     cmd->add_option("--method", o->method,
-                    "Rendering method: path (volumetric path tracer, the reference) or vrl (transport parts "
-                    "(a)-(c) by path sampling, multiple scattering (d) by plain VRLs)")
+                    "Rendering method: path (volumetric path tracer, the reference), vrl (transport parts "
+                    "(a)-(c) by path sampling, multiple scattering (d) by plain VRLs) or vrl-lightcuts (the same, "
+                    "(d) by cuts through a VRL light tree)")
         ->check(CLI::IsMember(kRenderMethods));
     cmd->add_option("--spp", o->spp, "Samples per pixel (default: the scene's sampler sampleCount)")
         ->check(CLI::Range(1, kMaxSampleCount));
@@ -198,6 +222,22 @@ void registerRenderCommand(CLI::App& app, int& exitCode) {
     cmd->add_option("--transport", o->transport,
                     "vrl: parts to render, comma-separated: surface (a), single (b), medium-surface (c), multiple (d); "
                     "each is also written as an EXR layer (default: all four)");
+    cmd->add_option("--error", o->error,
+                    "vrl-lightcuts: relative error threshold; a node is refined while its bound exceeds this times "
+                    "the current estimate (default 0.02)")
+        ->check(CLI::Range(0.0f, 1e6f));
+    cmd->add_option("--max-cut", o->maxCut, "vrl-lightcuts: most nodes in one cut, a safety valve (default 4096)")
+        ->check(CLI::Range(1u, 1u << 30));
+    cmd->add_option("--exact-distance-below", o->exactDistanceBelow,
+                    "vrl-lightcuts: nodes with at most this many VRLs take their distance to the camera ray from "
+                    "their VRLs rather than their box (default 32)")
+        ->check(CLI::Range(0u, 1u << 20));
+    cmd->add_option("--hg-epsilon", o->hgEpsilon,
+                    "vrl-lightcuts: Henyey-Greenstein media multiply the isotropic bound by (1 + this) (default 1)")
+        ->check(CLI::Range(0.0f, 1e6f));
+    cmd->add_option("--partition-size", o->partitionSize,
+                    "vrl-lightcuts: VRLs per partition before agglomerative clustering (default 2048)")
+        ->check(CLI::Range(2u, 1u << 30));
     cmd->add_flag("--jitter", o->jitter, "Jitter camera rays inside pixels (default: through pixel centres)");
     cmd->add_flag("-q,--quiet", o->quiet, "No progress bar and no informational logs");
     cmd->callback([o, &exitCode] {

@@ -1,6 +1,7 @@
 #include "render/renderer.h"
 
 #include "render/light_tracer.h"
+#include "render/light_tree.h"
 #include "render/path_tracer.h"
 #include "render/vrl_integrator.h"
 
@@ -63,7 +64,7 @@ ImageSet renderPath(const Scene& scene, const RenderSettings& settings, const Pr
 }
 
 ImageSet renderVrl(const Scene& scene, const RenderSettings& settings, const ProgressCallback& progress,
-                   RenderStatistics& statistics) {
+                   RenderStatistics& statistics, bool lightcuts) {
     VrlSet vrls;
     if (settings.transports.has(TransportPart::Multiple)) {
         LightTracingSettings tracing;
@@ -79,13 +80,26 @@ ImageSet renderVrl(const Scene& scene, const RenderSettings& settings, const Pro
         statistics.vrlBytes = vrls.memoryBytes();
         statistics.tracingSeconds = vrls.tracingSeconds;
     }
+    LightTree tree;
+    if (lightcuts && !vrls.vrls.empty()) {
+        if (progress) progress("building the light tree", 0.0);
+        const auto treeStart = std::chrono::steady_clock::now();
+        tree = LightTree::build(vrls.vrls, LightTreeSettings{settings.partitionSize, settings.seed});
+        statistics.treeSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - treeStart).count();
+        statistics.treeBytes = tree.memoryBytes();
+        if (progress) progress("building the light tree", 1.0);
+    }
     const auto start = std::chrono::steady_clock::now();
     const PerspectiveCamera& camera = scene.camera();
     const int width = camera.width(), height = camera.height();
-    VrlIntegratorSettings integratorSettings{settings.transports, settings.maxDepth, settings.vrlSamples};
-    const VrlIntegrator integrator(scene, vrls, integratorSettings);
+    const VrlIntegratorSettings integratorSettings{settings.transports, settings.maxDepth, settings.vrlSamples,
+                                                   settings.cut};
+    const VrlIntegrator integrator(scene, vrls, integratorSettings, lightcuts ? &tree : nullptr);
     std::array<Image, 4> parts;
     for (auto& part : parts) part = Image(width, height);
+    std::array<Image, 3> cutLayers;  // eval, inter, cut
+    if (lightcuts)
+        for (auto& layer : cutLayers) layer = Image(width, height);
     forEachPixel(width, height, settings, progress, [&](int x, int y, Rng& rng) {
         std::array<Rgb, 4> sum{Rgb(0.0f), Rgb(0.0f), Rgb(0.0f), Rgb(0.0f)};
         for (int s = 0; s < settings.samplesPerPixel; ++s) {
@@ -94,7 +108,13 @@ ImageSet renderVrl(const Scene& scene, const RenderSettings& settings, const Pro
         }
         for (size_t p = 0; p < 3; ++p) parts[p].at(x, y) = sum[p] / float(settings.samplesPerPixel);
         // (d) once per pixel: its cost is per VRL, not per camera sample.
-        parts[3].at(x, y) = integrator.multipleScattering(cameraRay(camera, settings, x, y, rng), rng);
+        CutStatistics cut;
+        parts[3].at(x, y) = integrator.multipleScattering(cameraRay(camera, settings, x, y, rng), rng, &cut);
+        if (lightcuts) {
+            cutLayers[0].at(x, y) = Rgb(float(cut.evaluated));
+            cutLayers[1].at(x, y) = Rgb(float(cut.intersected));
+            cutLayers[2].at(x, y) = Rgb(float(cut.cutSize));
+        }
     });
     ImageSet result;
     result.image = Image(width, height);
@@ -102,6 +122,17 @@ ImageSet renderVrl(const Scene& scene, const RenderSettings& settings, const Pro
         if (!settings.transports.enabled[p]) continue;
         for (size_t i = 0; i < result.image.pixelCount(); ++i) result.image[i] += parts[p][i];
         result.layers.emplace_back(std::string(kTransportPartNames[p]), std::move(parts[p]));
+    }
+    if (lightcuts) {
+        double sums[3] = {0, 0, 0};
+        for (size_t l = 0; l < 3; ++l)
+            for (const auto& p : cutLayers[l].pixels()) sums[l] += p.x;
+        const double n = double(width) * height;
+        statistics.meanEvaluated = sums[0] / n;
+        statistics.meanIntersected = sums[1] / n;
+        statistics.meanCutSize = sums[2] / n;
+        const char* names[] = {"eval", "inter", "cut"};
+        for (size_t l = 0; l < 3; ++l) result.layers.emplace_back(names[l], std::move(cutLayers[l]));
     }
     statistics.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     return result;
@@ -120,8 +151,9 @@ ImageSet render(const Scene& scene, const RenderSettings& settings, const Progre
     if (settings.vrlSamples < 1) throw std::invalid_argument("samples per VRL must be at least 1");
     RenderStatistics stats;
     ImageSet result;
-    if (settings.method == "vrl") {
-        result = renderVrl(scene, settings, progress, stats);
+    if (settings.method == "vrl" || settings.method == "vrl-lightcuts") {
+        if (!(settings.cut.errorThreshold >= 0.0f)) throw std::invalid_argument("the error threshold must be >= 0");
+        result = renderVrl(scene, settings, progress, stats, settings.method == "vrl-lightcuts");
     } else {
         const auto start = std::chrono::steady_clock::now();
         result = renderPath(scene, settings, progress);

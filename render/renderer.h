@@ -3,6 +3,7 @@
 // image is bit-identical whatever the thread count or tile order.
 #pragma once
 
+#include "render/cut.h"
 #include "render/image.h"
 #include "render/scene.h"
 #include "render/transport.h"
@@ -17,7 +18,9 @@ namespace vrl {
 // Methods the renderer knows; `vrl render --method` takes these names.
 //   path: the volumetric path tracer (reference), one image
 //   vrl:  the four transport parts, multiple scattering by plain VRLs; one layer per part
-inline const std::vector<std::string> kRenderMethods = {"path", "vrl"};
+//   vrl-lightcuts: the same, multiple scattering by cuts through a VRL light tree,
+//         plus per-pixel layers "eval", "inter" and "cut" (statistics)
+inline const std::vector<std::string> kRenderMethods = {"path", "vrl", "vrl-lightcuts"};
 
 struct RenderSettings {
     std::string method = "path";
@@ -31,6 +34,9 @@ struct RenderSettings {
     uint64_t vrlCount = 100000;  // target VRLs (whole light paths are kept)
     uint64_t lightPaths = 0;     // if > 0: trace exactly this many light paths instead
     int vrlSamples = 1;          // (u, v) samples per VRL and camera segment
+    // vrl-lightcuts method
+    CutSettings cut;             // error threshold, maximum cut, bound parameters
+    uint32_t partitionSize = 2048;  // light tree: VRLs per partition of the median-split phase
 };
 
 struct RenderStatistics {
@@ -41,6 +47,10 @@ struct RenderStatistics {
     uint64_t lightPaths = 0;
     size_t vrlBytes = 0;
     double tracingSeconds = 0.0;
+    // vrl-lightcuts method
+    double treeSeconds = 0.0;
+    size_t treeBytes = 0;
+    double meanEvaluated = 0.0, meanIntersected = 0.0, meanCutSize = 0.0;  // per pixel
 };
 
 // Called from worker threads with the fraction done of a phase ("light tracing",

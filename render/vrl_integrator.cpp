@@ -4,12 +4,16 @@
 
 namespace vrl {
 
-VrlIntegrator::VrlIntegrator(const Scene& scene, const VrlSet& vrls, const VrlIntegratorSettings& settings)
+VrlIntegrator::VrlIntegrator(const Scene& scene, const VrlSet& vrls, const VrlIntegratorSettings& settings,
+                             const LightTree* tree)
     : scene_(scene),
       vrls_(vrls),
       settings_(settings),
       tracer_(scene, PathTracerSettings{settings.maxDepth}),
-      estimator_(scene, settings.vrlSamples) {}
+      estimator_(scene, settings.vrlSamples),
+      tree_(tree) {
+    if (tree_) lightcuts_ = std::make_unique<LightcutsEstimator>(scene, *tree_, estimator_, settings.cut);
+}
 
 std::array<Rgb, 4> VrlIntegrator::samplePathParts(const Ray& cameraRay, Rng& rng) const {
     std::array<Rgb, 4> parts{Rgb(0.0f), Rgb(0.0f), Rgb(0.0f), Rgb(0.0f)};
@@ -73,12 +77,26 @@ Rgb VrlIntegrator::mediumToSurface(const CameraSegment& segment, Rng& rng) const
            float(1.0 / pdf);
 }
 
-Rgb VrlIntegrator::multipleScattering(const Ray& cameraRay, Rng& rng) const {
+Rgb VrlIntegrator::multipleScattering(const Ray& cameraRay, Rng& rng, CutStatistics* statistics) const {
     Rgb sum(0.0f);
     if (!settings_.transports.has(TransportPart::Multiple)) return sum;
+    CutStatistics unused;
+    // One stream family per camera segment; VRL k draws from (key, k) in both plain
+    // and Lightcuts shading, so the two differ only by the cut's approximation.
+    const uint64_t pixelKey = (uint64_t(rng.nextUint()) << 32) | rng.nextUint();
+    uint64_t segmentIndex = 0;
     for (const CameraSegment& segment : cameraSegments(scene_, cameraRay, scene_.cameraMedium())) {
+        const uint64_t streamKey = Rng::combine(pixelKey, segmentIndex++);
         if (scene_.media()[segment.medium].isNonScattering()) continue;
-        for (const Vrl& v : vrls_.vrls) sum += estimator_.contribution(v, segment, rng);
+        if (lightcuts_) {
+            sum += lightcuts_->estimate(segment, streamKey, statistics ? *statistics : unused);
+        } else {
+            const auto& vrls = tree_ ? tree_->vrls() : vrls_.vrls;
+            for (uint32_t k = 0; k < vrls.size(); ++k) {
+                Rng vrlRng = vrlStream(streamKey, k);
+                sum += estimator_.contribution(vrls[k], segment, vrlRng);
+            }
+        }
     }
     return sum;
 }

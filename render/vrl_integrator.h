@@ -10,12 +10,15 @@
 // to the reference path tracer's image.
 #pragma once
 
+#include "render/cut.h"
+#include "render/light_tree.h"
 #include "render/path_tracer.h"
 #include "render/transport.h"
 #include "render/vrl.h"
 #include "render/vrl_estimator.h"
 
 #include <array>
+#include <memory>
 
 namespace vrl {
 
@@ -23,16 +26,19 @@ struct VrlIntegratorSettings {
     TransportSelection transports;
     int maxDepth = -1;
     int vrlSamples = 1;  // (u, v) samples per VRL and camera segment
+    CutSettings cut;     // used when a light tree is given
 };
 
 class VrlIntegrator {
 public:
-    VrlIntegrator(const Scene& scene, const VrlSet& vrls, const VrlIntegratorSettings& settings);
+    // Part (d) sums every VRL of `vrls`, or, when `tree` is given, walks Lightcuts over it.
+    VrlIntegrator(const Scene& scene, const VrlSet& vrls, const VrlIntegratorSettings& settings,
+                  const LightTree* tree = nullptr);
 
     // Parts (a), (b), (c) for one camera ray: one sample each.
     std::array<Rgb, 4> samplePathParts(const Ray& cameraRay, Rng& rng) const;
-    // Part (d) for one camera ray: every VRL against every camera segment.
-    Rgb multipleScattering(const Ray& cameraRay, Rng& rng) const;
+    // Part (d) for one camera ray: every VRL (or a cut) against every camera segment.
+    Rgb multipleScattering(const Ray& cameraRay, Rng& rng, CutStatistics* statistics = nullptr) const;
 
 private:
     Rgb singleScattering(const CameraSegment& segment, Rng& rng) const;
@@ -43,6 +49,8 @@ private:
     VrlIntegratorSettings settings_;
     VolumetricPathTracer tracer_;
     VrlEstimator estimator_;
+    const LightTree* tree_;
+    std::unique_ptr<LightcutsEstimator> lightcuts_;
 };
 
 }  // namespace vrl

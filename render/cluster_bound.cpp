@@ -1,0 +1,119 @@
+#include "render/cluster_bound.h"
+
+#include "render/scene.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace vrl {
+
+namespace {
+using V3d = Imath::V3d;
+V3d toDouble(const Vec3& v) { return {v.x, v.y, v.z}; }
+// Float noise in the estimator's own arithmetic (rounded sample points): the bound
+// carries this relative margin.
+constexpr double kRoundingMargin = 1.001;
+}  // namespace
+
+double maxSubtendedAngle(double segmentLength, double h) {
+    if (!(h > 0.0)) return M_PI;
+    return 2.0 * std::atan(segmentLength / (2.0 * h));
+}
+
+double distanceLineSegment(const Vec3& origin, const Vec3& direction, const Vec3& a, const Vec3& b) {
+    const V3d d = toDouble(direction);
+    const V3d ra = toDouble(a - origin), ab = toDouble(b - a);
+    const V3d p = ra - d * d.dot(ra), q = ab - d * d.dot(ab);  // components across the line
+    const double qq = q.length2();
+    const double s = qq > 0.0 ? std::clamp(-p.dot(q) / qq, 0.0, 1.0) : 0.0;
+    return (p + q * s).length();
+}
+
+double distanceLineBox(const Vec3& origin, const Vec3& direction, const Imath::Box3f& box) {
+    if (box.isEmpty()) return std::numeric_limits<double>::infinity();
+    // Does the infinite line pass through the box? (slab test over all t)
+    double tNear = -std::numeric_limits<double>::infinity(), tFar = std::numeric_limits<double>::infinity();
+    bool crosses = true;
+    for (int axis = 0; axis < 3 && crosses; ++axis) {
+        const double o = origin[axis], d = direction[axis], lo = box.min[axis], hi = box.max[axis];
+        if (d == 0.0) {
+            crosses = o >= lo && o <= hi;
+        } else {
+            double t0 = (lo - o) / d, t1 = (hi - o) / d;
+            if (t0 > t1) std::swap(t0, t1);
+            tNear = std::max(tNear, t0);
+            tFar = std::min(tFar, t1);
+            crosses = tNear <= tFar;
+        }
+    }
+    if (crosses) return 0.0;
+    // Otherwise the distance, a convex function over the box, is smallest on an edge.
+    double best = std::numeric_limits<double>::infinity();
+    const Vec3 lo = box.min, hi = box.max;
+    for (int axis = 0; axis < 3; ++axis) {
+        const int u = (axis + 1) % 3, v = (axis + 2) % 3;
+        for (int corner = 0; corner < 4; ++corner) {
+            Vec3 a, b;
+            a[u] = b[u] = (corner & 1) ? hi[u] : lo[u];
+            a[v] = b[v] = (corner & 2) ? hi[v] : lo[v];
+            a[axis] = lo[axis];
+            b[axis] = hi[axis];
+            best = std::min(best, distanceLineSegment(origin, direction, a, b));
+        }
+    }
+    return best;
+}
+
+ClusterBound::ClusterBound(const Scene& scene, const LightTree& tree, ClusterBoundSettings settings)
+    : scene_(scene), tree_(tree), settings_(settings) {
+    for (const auto& m : scene.media()) {
+        for (int c = 0; c < 3; ++c) maxSigmaS_[c] = std::max(maxSigmaS_[c], m.sigmaS()[c]);
+    }
+}
+
+double ClusterBound::minimumDistance(int32_t index, const CameraSegment& segment) const {
+    const LightTreeNode& node = tree_.nodes()[index];
+    if (node.vrlCount > settings_.exactDistanceBelow)
+        return distanceLineBox(segment.origin, segment.direction, node.box);
+    // Small node: the exact distance from its VRL segments.
+    double best = std::numeric_limits<double>::infinity();
+    int32_t stack[64];
+    int top = 0;
+    stack[top++] = index;
+    while (top > 0) {
+        const LightTreeNode& n = tree_.nodes()[stack[--top]];
+        if (n.isLeaf()) {
+            const Vrl& v = tree_.vrls()[n.representative];
+            best = std::min(best, distanceLineSegment(segment.origin, segment.direction, v.origin, v.end()));
+        } else if (top + 2 <= 64) {
+            stack[top++] = n.left;
+            stack[top++] = n.right;
+        } else {  // deeper than expected for a small node: fall back to the box
+            return distanceLineBox(segment.origin, segment.direction, node.box);
+        }
+    }
+    return best;
+}
+
+Rgb ClusterBound::bound(int32_t index, const CameraSegment& segment, bool* lineCrossesNode) const {
+    const LightTreeNode& node = tree_.nodes()[index];
+    const double h = minimumDistance(index, segment);
+    if (lineCrossesNode) *lineCrossesNode = !(h > 0.0);
+    if (!(h > 0.0)) return Rgb(std::numeric_limits<float>::infinity());
+    const HomogeneousMedium& cameraMedium = scene_.media()[segment.medium];
+    const HomogeneousMedium* vrlMedium = node.medium >= 0 ? &scene_.media()[node.medium] : nullptr;
+    const Rgb sigmaSV = vrlMedium ? vrlMedium->sigmaS() : maxSigmaS_;
+    const bool isotropic = cameraMedium.phase().isIsotropic() && (!vrlMedium || vrlMedium->phase().isIsotropic()) &&
+                           (vrlMedium || std::all_of(scene_.media().begin(), scene_.media().end(),
+                                                     [](const auto& m) { return m.phase().isIsotropic(); }));
+    double phase = double(kInv4Pi) * double(kInv4Pi);
+    if (!isotropic) phase *= 1.0 + settings_.anisotropyEpsilon;
+    // T_r(w) <= T_r(h_min) only if the segment between u and v stays in this one convex medium.
+    Rgb between(1.0f);
+    if (node.medium == segment.medium && cameraMedium.boundaryConvex()) between = cameraMedium.transmittance(float(h));
+    const double scale = kRoundingMargin * phase * maxSubtendedAngle(segment.length, h) * node.maxLength / h;
+    return node.clusterFlux * sigmaSV * cameraMedium.sigmaS() * segment.transmittanceBefore * between * float(scale);
+}
+
+}  // namespace vrl

@@ -1,0 +1,57 @@
+// ClusterBound: an upper bound on the single-sample VRL estimate of a light-tree
+// node for one camera segment (Vibert et al. 2019, Eq. 8-11), used to decide
+// whether the cut must refine the node.
+//
+// Derivation (isotropic phase). With v drawn with p(v) = s/((A1-A0) h(v)) on the
+// VRL (h(v): distance from v to the camera *line*, s = sin of the angle between
+// the lines) and u equiangularly with p(u|v) w^2 = h(v)/(thetaB - thetaA), the
+// h(v) factors cancel:  1/(w^2 p(v) p(u|v)) = (thetaB - thetaA) (A1 - A0)/s,
+// and (A1 - A0)/s = integral of dv/h(v) over the VRL <= L / h_min (parallel
+// lines: p(v) = 1/L gives the same). thetaB - thetaA, the angle the camera
+// segment (length S) subtends from a point at distance h from its line, is at
+// most 2 atan(S / (2 h)) (foot point in the middle) — the paper prints
+// 2 atan(2h/S), which is inverted: it must tend to pi as S -> infinity. So
+//   estimate <= Phi_C sigma_s(u) sigma_s(v) f^2 T_before T_r(h_min) theta_max L_max / h_min,
+// with h_min <= distance between the node's VRLs and the camera line, T_r(h_min)
+// only for media whose boundary is convex (else 1), visibility and T_r(u)
+// bounded by 1. A line through the node's box (h_min = 0) gives an infinite
+// bound: the node is always refined. Henyey-Greenstein media have no such
+// bound; theirs is the isotropic one times (1 + epsilon) (a heuristic).
+#pragma once
+
+#include "render/camera_segment.h"
+#include "render/light_tree.h"
+
+namespace vrl {
+
+class Scene;
+
+struct ClusterBoundSettings {
+    uint32_t exactDistanceBelow = 32;  // nodes with at most this many VRLs: h_min from their segments
+    float anisotropyEpsilon = 1.0f;    // HG media: bound x (1 + epsilon)
+};
+
+// The largest angle a segment of length `segmentLength` subtends from distance h.
+double maxSubtendedAngle(double segmentLength, double h);
+// Distance between the infinite line (origin, unit direction) and a box / a segment.
+double distanceLineBox(const Vec3& origin, const Vec3& direction, const Imath::Box3f& box);
+double distanceLineSegment(const Vec3& origin, const Vec3& direction, const Vec3& a, const Vec3& b);
+
+class ClusterBound {
+public:
+    ClusterBound(const Scene& scene, const LightTree& tree, ClusterBoundSettings settings = {});
+
+    // RGB bound for `node` against `segment`; +infinity when the
+    // camera line passes through the node (h_min = 0).
+    Rgb bound(int32_t node, const CameraSegment& segment, bool* lineCrossesNode = nullptr) const;
+    // The minimum distance used for the node (box, or exact for small nodes).
+    double minimumDistance(int32_t node, const CameraSegment& segment) const;
+
+private:
+    const Scene& scene_;
+    const LightTree& tree_;
+    ClusterBoundSettings settings_;
+    Rgb maxSigmaS_{0.0f};       // over all media: for nodes spanning several
+};
+
+}  // namespace vrl
