@@ -70,29 +70,54 @@ ClusterBound::ClusterBound(const Scene& scene, const LightTree& tree, ClusterBou
     for (const auto& m : scene.media()) {
         for (int c = 0; c < 3; ++c) maxSigmaS_[c] = std::max(maxSigmaS_[c], m.sigmaS()[c]);
     }
+    if (tree.empty()) return;
+    const auto& nodes = tree.nodes();
+    firstLeaf_.assign(nodes.size(), 0);
+    leafStart_.reserve(tree.vrls().size());
+    leafEnd_.reserve(tree.vrls().size());
+    std::vector<int32_t> stack{tree.root()};
+    while (!stack.empty()) {  // depth first, left before right
+        const int32_t i = stack.back();
+        stack.pop_back();
+        if (nodes[i].isLeaf()) {
+            const Vrl& v = tree.vrls()[nodes[i].representative];
+            leafStart_.push_back(v.origin);
+            leafEnd_.push_back(v.end());
+            continue;
+        }
+        stack.push_back(nodes[i].right);
+        stack.push_back(nodes[i].left);
+    }
+    // A node's first leaf is its left-most descendant's position: fill bottom-up
+    // by a second walk in the same order.
+    uint32_t next = 0;
+    std::vector<std::pair<int32_t, bool>> walk{{tree.root(), false}};
+    while (!walk.empty()) {
+        auto [i, visited] = walk.back();
+        walk.pop_back();
+        if (nodes[i].isLeaf()) {
+            firstLeaf_[i] = next++;
+            continue;
+        }
+        if (!visited) {
+            walk.push_back({i, true});
+            walk.push_back({nodes[i].right, false});
+            walk.push_back({nodes[i].left, false});
+        } else {
+            firstLeaf_[i] = firstLeaf_[nodes[i].left];
+        }
+    }
 }
 
 double ClusterBound::minimumDistance(int32_t index, const CameraSegment& segment) const {
     const LightTreeNode& node = tree_.nodes()[index];
     if (node.vrlCount > settings_.exactDistanceBelow)
         return distanceLineBox(segment.origin, segment.direction, node.box);
-    // Small node: the exact distance from its VRL segments.
+    // Small node: the exact distance from its VRL segments (a contiguous range).
     double best = std::numeric_limits<double>::infinity();
-    int32_t stack[64];
-    int top = 0;
-    stack[top++] = index;
-    while (top > 0) {
-        const LightTreeNode& n = tree_.nodes()[stack[--top]];
-        if (n.isLeaf()) {
-            const Vrl& v = tree_.vrls()[n.representative];
-            best = std::min(best, distanceLineSegment(segment.origin, segment.direction, v.origin, v.end()));
-        } else if (top + 2 <= 64) {
-            stack[top++] = n.left;
-            stack[top++] = n.right;
-        } else {  // deeper than expected for a small node: fall back to the box
-            return distanceLineBox(segment.origin, segment.direction, node.box);
-        }
-    }
+    const uint32_t first = firstLeaf_[index];
+    for (uint32_t k = first; k < first + node.vrlCount; ++k)
+        best = std::min(best, distanceLineSegment(segment.origin, segment.direction, leafStart_[k], leafEnd_[k]));
     return best;
 }
 

@@ -22,6 +22,8 @@
 #include "render/camera_segment.h"
 #include "render/light_tree.h"
 
+#include <vector>
+
 namespace vrl {
 
 class Scene;
@@ -51,7 +53,11 @@ private:
     const Scene& scene_;
     const LightTree& tree_;
     ClusterBoundSettings settings_;
-    Rgb maxSigmaS_{0.0f};       // over all media: for nodes spanning several
+    Rgb maxSigmaS_{0.0f};  // over all media: for nodes spanning several
+    // VRL endpoints in depth-first leaf order, so that every node's VRLs are the
+    // contiguous range [firstLeaf_[node], firstLeaf_[node] + vrlCount).
+    std::vector<Vec3> leafStart_, leafEnd_;
+    std::vector<uint32_t> firstLeaf_;
 };
 
 }  // namespace vrl

@@ -1,0 +1,127 @@
+// lightcuts_bench: VRL Lightcuts against plain VRLs on a scene (default: the
+// default scene), for several VRL counts. Prints, per N: light tracing time,
+// hybrid tree build time and memory, the global agglomerative build's time and
+// the hybrid tree's extra gathering cost against it (N <= --global-max), and the
+// shading time of part (d) with plain VRLs and with Lightcuts at the error
+// threshold, their ratio, the relative RMSE between the two images and #Eval,
+// #Inter and cut size per pixel (the paper's Table 1). Timings are wall-clock,
+// one run each, on whatever cores TBB gets: compare ratios, not seconds.
+#include "render/cut.h"
+#include "render/image_metrics.h"
+#include "render/light_tracer.h"
+#include "render/light_tree.h"
+#include "render/mitsuba_parser.h"
+#include "render/scene.h"
+#include "render/vrl_integrator.h"
+
+#include <CLI/CLI.hpp>
+#include <tbb/parallel_for.h>
+
+#include <atomic>
+#include <chrono>
+#include <cstdio>
+
+using namespace vrl;
+
+namespace {
+
+double secondsSince(std::chrono::steady_clock::time_point t) {
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
+}
+
+struct Shading {
+    Image image;
+    double seconds = 0.0;
+    CutStatistics total;
+};
+
+// Part (d) on every `stride`-th pixel in x and y (the others stay black).
+Shading shade(const Scene& scene, const VrlSet& vrls, const LightTree* tree, float error, int stride, uint64_t seed) {
+    VrlIntegratorSettings settings;
+    settings.transports = TransportSelection::parse("multiple");
+    settings.cut.errorThreshold = error;
+    const VrlIntegrator integrator(scene, vrls, settings, tree);
+    const PerspectiveCamera& camera = scene.camera();
+    Shading out;
+    out.image = Image(camera.width(), camera.height());
+    std::atomic<uint64_t> evaluated{0}, intersected{0}, cutSize{0};
+    const auto start = std::chrono::steady_clock::now();
+    tbb::parallel_for(0, (camera.height() + stride - 1) / stride, [&](int row) {
+        const int y = row * stride;
+        for (int x = 0; x < camera.width(); x += stride) {
+            Rng rng(seed, uint64_t(y) * camera.width() + x);
+            CutStatistics stats;
+            out.image.at(x, y) = integrator.multipleScattering(camera.generateRay(x + 0.5f, y + 0.5f), rng, &stats);
+            evaluated += stats.evaluated, intersected += stats.intersected, cutSize += stats.cutSize;
+        }
+    });
+    out.seconds = secondsSince(start);
+    out.total = {uint32_t(evaluated.load()), uint32_t(intersected.load()), uint32_t(cutSize.load())};
+    return out;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+    CLI::App app{"VRL Lightcuts against plain VRLs (part (d) only)"};
+    std::string scenePath = "scenes/smoke-room.xml";
+    std::vector<uint64_t> counts = {10000, 100000, 1000000};
+    std::string resolution = "64x48";
+    float error = 0.02f;
+    uint64_t globalMax = 100000;
+    uint64_t strideAbove = 200000;
+    int stride = 4;
+    app.add_option("--scene", scenePath, "Scene file (default scenes/smoke-room.xml)");
+    app.add_option("--vrls", counts, "VRL counts to run (default 10000 100000 1000000)");
+    app.add_option("--resolution", resolution, "Image size WxH for shading (default 64x48)");
+    app.add_option("--error", error, "Lightcuts error threshold (default 0.02)");
+    app.add_option("--global-max", globalMax, "Largest N for the global agglomerative baseline (default 100000)");
+    app.add_option("--stride-above", strideAbove, "Above this N, shade every --stride-th pixel in x and y (default 200000)");
+    app.add_option("--stride", stride, "Pixel stride for large N (default 4: 1/16 of the pixels)");
+    CLI11_PARSE(app, argc, argv);
+
+    SceneDescription description = parseMitsubaScene(scenePath);
+    int w = 0, h = 0;
+    if (std::sscanf(resolution.c_str(), "%dx%d", &w, &h) != 2 || w < 1 || h < 1) {
+        std::fprintf(stderr, "bad --resolution '%s'\n", resolution.c_str());
+        return 2;
+    }
+    description.sensor.width = w;
+    description.sensor.height = h;
+    const auto scene = Scene::build(description);
+    std::printf("scene %s, %dx%d, error threshold %.3f, part (d) only\n", scenePath.c_str(), w, h, error);
+    std::printf("%9s %8s %9s %8s %9s %10s %9s %9s %8s %9s %8s %8s %8s\n", "VRLs", "trace_s", "build_s", "tree_MB",
+                "global_s", "gatherX", "plain_s", "cuts_s", "speedup", "relRMSE", "#Eval", "#Inter", "cut");
+    for (uint64_t n : counts) {
+        LightTracingSettings tracing;
+        tracing.targetVrls = n;
+        tracing.maxDepth = description.integrator.maxDepth;
+        auto start = std::chrono::steady_clock::now();
+        const VrlSet vrls = traceVrls(*scene, tracing);
+        const double traceSeconds = secondsSince(start);
+        start = std::chrono::steady_clock::now();
+        const LightTree tree = LightTree::build(vrls.vrls);
+        const double buildSeconds = secondsSince(start);
+        const int s = n > strideAbove ? stride : 1;
+        const double pixels = double((w + s - 1) / s) * ((h + s - 1) / s);
+        const Shading cuts = shade(*scene, vrls, &tree, error, s, 1);
+        const Shading plain = shade(*scene, vrls, nullptr, error, s, 1);
+        std::string global = "-", gather = "-";
+        if (n <= globalMax) {
+            start = std::chrono::steady_clock::now();
+            const LightTree globalTree = LightTree::build(vrls.vrls, LightTreeSettings{uint32_t(vrls.vrls.size()), 0});
+            global = std::to_string(secondsSince(start)).substr(0, 7);
+            const Shading globalCuts = shade(*scene, vrls, &globalTree, error, s, 1);
+            gather = std::to_string(double(cuts.total.evaluated) / std::max(1u, globalCuts.total.evaluated)).substr(0, 5);
+        }
+        const ImageErrorMetrics m = compareImages(plain.image, cuts.image);
+        std::printf("%9zu %8.3f %9.3f %8.1f %9s %10s %9.2f %9.2f %8.1f %9.5f %8.0f %8.0f %8.0f%s\n", vrls.vrls.size(),
+                    traceSeconds, buildSeconds, tree.memoryBytes() / 1e6, global.c_str(), gather.c_str(),
+                    plain.seconds, cuts.seconds, plain.seconds / cuts.seconds, m.relativeRmse,
+                    cuts.total.evaluated / pixels, cuts.total.intersected / pixels, cuts.total.cutSize / pixels,
+                    s > 1 ? "  (1/16 of the pixels)" : "");
+        std::fflush(stdout);
+    }
+    std::printf("gatherX: #Eval of the hybrid tree over #Eval of the global agglomerative tree (paper: 1.25)\n");
+    return 0;
+}
