@@ -21,7 +21,9 @@
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
+#include <limits>
 #include <ostream>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -72,11 +74,12 @@ Vec3 randomDirection(Rng& rng) {
     }
 }
 
-enum class RandomKind { Mixed, Identical, Plane, Line, AllZeroLength };
+enum class RandomKind { Mixed, Identical, Plane, Line, AllZeroLength, Scattered };
 
 // `n` random VRLs of the given kind, from the stream (seed, kind).
-// Mixed: scattered in a box, 10% of zero length, 5% black, 10% exact copies
-// of earlier VRLs, fluxes over three decades, three media.
+// Scattered: in a box [-5, 5]^3, random directions, lengths in [0.01, 0.51],
+// fluxes over three decades, three media. Mixed: the same with 10% of zero
+// length, 5% black and 10% exact copies of earlier VRLs.
 std::vector<Vrl> randomVrls(size_t n, RandomKind kind, uint64_t seed) {
     Rng rng(seed, uint64_t(kind));
     std::vector<Vrl> vrls;
@@ -116,6 +119,7 @@ std::vector<Vrl> randomVrls(size_t n, RandomKind kind, uint64_t seed) {
             v.medium = 2;
             break;
         case RandomKind::AllZeroLength: v.length = 0.0f; break;
+        case RandomKind::Scattered: break;
         }
         vrls.push_back(v);
     }
@@ -558,13 +562,206 @@ TEST(LightTree, BuiltTreeRoundTripsThroughSerialisationBitExactly) {
 }
 
 // ---------------------------------------------------------------------------
-// Quality: the hybrid build against the global agglomerative one on ~5k
-// light-traced VRLs of the smoke room. Measured (seed 3): partitionSize 2048
-// (4 partitions) costs ~1.0x the global build, partitionSize 64 (~128
-// partitions) ~1.1x; the paper reports a 25% gathering overhead for its
-// hybrid tree. The bound 1.5x leaves room for other scenes' light paths while
-// still catching a broken split or merge rule (a median-split tree without
-// agglomeration is several times worse).
+// The merge rule against a brute-force reference: the greedy clustering that
+// repeatedly merges the pair of clusters minimising I_c E_c^2 (luminance of
+// the merged flux x length times the merged box's squared diagonal), in
+// double. Random scattered VRLs (no copies, no zero weights) make ties
+// improbable, so the tree must hold exactly the reference's clusters.
+
+struct RefCluster {
+    double lo[3], hi[3];
+    double weight;  // luminance of flux x length (linear, so summable)
+    std::vector<uint32_t> members;  // sorted VRL indices
+};
+
+RefCluster refLeaf(const std::vector<Vrl>& vrls, uint32_t i) {
+    const Vrl& v = vrls[i];
+    const Vec3 a = v.origin, b = v.end();
+    RefCluster c;
+    for (int k = 0; k < 3; ++k) c.lo[k] = std::min(a[k], b[k]), c.hi[k] = std::max(a[k], b[k]);
+    c.weight = luminance(v.flux * v.length);
+    c.members = {i};
+    return c;
+}
+
+RefCluster refJoin(const RefCluster& a, const RefCluster& b) {
+    RefCluster c;
+    for (int k = 0; k < 3; ++k) c.lo[k] = std::min(a.lo[k], b.lo[k]), c.hi[k] = std::max(a.hi[k], b.hi[k]);
+    c.weight = a.weight + b.weight;
+    c.members = a.members;
+    c.members.insert(c.members.end(), b.members.begin(), b.members.end());
+    std::sort(c.members.begin(), c.members.end());
+    return c;
+}
+
+double refCost(const RefCluster& a, const RefCluster& b) {
+    double diagonal2 = 0;
+    for (int k = 0; k < 3; ++k) {
+        const double d = std::max(a.hi[k], b.hi[k]) - std::min(a.lo[k], b.lo[k]);
+        diagonal2 += d * d;
+    }
+    return (a.weight + b.weight) * diagonal2;
+}
+
+// The clusters (as sorted VRL index lists) that greedy agglomeration of `live` creates.
+std::set<std::vector<uint32_t>> greedyClusters(std::vector<RefCluster> live) {
+    std::set<std::vector<uint32_t>> created;
+    while (live.size() > 1) {
+        size_t bestI = 0, bestJ = 1;
+        double best = std::numeric_limits<double>::infinity();
+        for (size_t i = 0; i < live.size(); ++i)
+            for (size_t j = i + 1; j < live.size(); ++j) {
+                const double cost = refCost(live[i], live[j]);
+                if (cost < best) best = cost, bestI = i, bestJ = j;
+            }
+        live[bestI] = refJoin(live[bestI], live[bestJ]);
+        created.insert(live[bestI].members);
+        live[bestJ] = std::move(live.back());
+        live.pop_back();
+    }
+    return created;
+}
+
+// Sorted VRL indices below every node.
+std::vector<std::vector<uint32_t>> membersOfNodes(const LightTree& tree) {
+    const auto& nodes = tree.nodes();
+    std::vector<std::vector<uint32_t>> members(nodes.size());
+    std::vector<std::pair<int32_t, bool>> stack{{tree.root(), false}};  // post-order
+    while (!stack.empty()) {
+        const auto [i, expanded] = stack.back();
+        stack.pop_back();
+        const LightTreeNode& node = nodes[size_t(i)];
+        if (node.isLeaf()) {
+            members[size_t(i)] = {node.representative};
+        } else if (!expanded) {
+            stack.push_back({i, true});
+            stack.push_back({node.left, false});
+            stack.push_back({node.right, false});
+        } else {
+            auto& m = members[size_t(i)];
+            m = members[size_t(node.left)];
+            m.insert(m.end(), members[size_t(node.right)].begin(), members[size_t(node.right)].end());
+            std::sort(m.begin(), m.end());
+        }
+    }
+    return members;
+}
+
+// N = 300: every inner node of the global build is a cluster of the reference.
+TEST(LightTree, GlobalBuildIsGreedyAgglomerationByLuminanceTimesSquaredDiagonal) {
+    const std::vector<Vrl> vrls = randomVrls(300, RandomKind::Scattered, 51);
+    LightTreeSettings settings;
+    settings.partitionSize = kGlobal;
+    const LightTree tree = LightTree::build(vrls, settings);
+    ASSERT_TRUE(structureIsValid(tree, vrls));
+    std::vector<RefCluster> leaves;
+    for (uint32_t i = 0; i < vrls.size(); ++i) leaves.push_back(refLeaf(vrls, i));
+    const std::set<std::vector<uint32_t>> expected = greedyClusters(leaves);
+    const auto members = membersOfNodes(tree);
+    const std::set<std::vector<uint32_t>> built(members.begin() + vrls.size(), members.end());
+    EXPECT_EQ(built.size(), vrls.size() - 1);
+    EXPECT_TRUE(built == expected) << "the global build differs from greedy agglomeration";
+}
+
+// N = 3000, partitionSize 64: six rounds of median splits give 64 partitions
+// of 46 or 47 VRLs, so the partitions are exactly the subtrees of at most 64
+// VRLs whose parent has more. Each must be the greedy agglomeration of its
+// VRLs, and the nodes above them the greedy agglomeration of the partitions.
+TEST(LightTree, HybridBuildIsGreedyInsideMedianSplitPartitionsAndAcrossThem) {
+    const std::vector<Vrl> vrls = randomVrls(3000, RandomKind::Scattered, 52);
+    const uint32_t partitionSize = 64;
+    LightTreeSettings settings;
+    settings.partitionSize = partitionSize;
+    const LightTree tree = LightTree::build(vrls, settings);
+    ASSERT_TRUE(structureIsValid(tree, vrls));
+    const auto& nodes = tree.nodes();
+    const auto members = membersOfNodes(tree);
+    std::vector<int32_t> parent(nodes.size(), -1);
+    for (size_t i = vrls.size(); i < nodes.size(); ++i) parent[size_t(nodes[i].left)] = parent[size_t(nodes[i].right)] = int32_t(i);
+    std::vector<size_t> partitions;
+    for (size_t i = 0; i < nodes.size(); ++i)
+        if (nodes[i].vrlCount <= partitionSize && (parent[i] < 0 || nodes[size_t(parent[i])].vrlCount > partitionSize))
+            partitions.push_back(i);
+    ASSERT_EQ(partitions.size(), 64u);
+    std::vector<RefCluster> partitionClusters;
+    for (size_t root : partitions) {
+        ASSERT_TRUE(nodes[root].vrlCount == 46 || nodes[root].vrlCount == 47) << at(root) << nodes[root].vrlCount;
+        std::vector<RefCluster> leaves;
+        for (uint32_t i : members[root]) leaves.push_back(refLeaf(vrls, i));
+        const std::set<std::vector<uint32_t>> expected = greedyClusters(leaves);
+        std::set<std::vector<uint32_t>> built;
+        for (size_t i = vrls.size(); i < nodes.size(); ++i)
+            if (nodes[i].vrlCount <= partitionSize && members[i].front() >= members[root].front() &&
+                std::includes(members[root].begin(), members[root].end(), members[i].begin(), members[i].end()))
+                built.insert(members[i]);
+        EXPECT_TRUE(built == expected) << "partition at " << at(root) << "differs from greedy agglomeration";
+        RefCluster c = leaves[0];
+        for (size_t k = 1; k < leaves.size(); ++k) c = refJoin(c, leaves[k]);
+        partitionClusters.push_back(c);
+    }
+    std::set<std::vector<uint32_t>> top;
+    for (size_t i = vrls.size(); i < nodes.size(); ++i)
+        if (nodes[i].vrlCount > partitionSize) top.insert(members[i]);
+    EXPECT_EQ(top.size(), 63u);
+    EXPECT_TRUE(top == greedyClusters(partitionClusters)) << "the merge of the partition roots differs from greedy";
+}
+
+TEST(LightTree, PartitionSizeAtLeastNIsTheGlobalBuild) {
+    const std::vector<Vrl> vrls = randomVrls(1500, RandomKind::Mixed, 53);
+    LightTreeSettings settings;
+    settings.seed = 4;
+    settings.partitionSize = 1500;
+    const LightTree exact = LightTree::build(vrls, settings);
+    settings.partitionSize = 2048;
+    const LightTree larger = LightTree::build(vrls, settings);
+    settings.partitionSize = kGlobal;
+    const LightTree global = LightTree::build(vrls, settings);
+    EXPECT_TRUE(identicalTrees(exact, global));
+    EXPECT_TRUE(identicalTrees(larger, global));
+}
+
+// Two slabs far apart in y, each wide in x: only a split along y gives child
+// boxes that do not overlap, so the first median split must separate the
+// slabs and no partition (the 8 subtrees of 64 VRLs) may mix them.
+TEST(LightTree, MedianSplitKeepsTheAxisWhoseHalvesOverlapLeast) {
+    Rng rng(54, 0);
+    std::vector<Vrl> vrls(512);
+    for (size_t i = 0; i < vrls.size(); ++i) {
+        Vrl& v = vrls[i];
+        const float slabY = i % 2 ? 10.0f : 0.0f;
+        v.origin = {100 * rng.next() - 50, slabY + rng.next() * 0.5f, 2 * rng.next() - 1};
+        v.direction = randomDirection(rng);
+        v.length = 0.2f + 0.3f * rng.next();
+        v.flux = Rgb(rng.next(), rng.next(), rng.next());
+        v.medium = 0;
+    }
+    LightTreeSettings settings;
+    settings.partitionSize = 64;
+    const LightTree tree = LightTree::build(vrls, settings);
+    ASSERT_TRUE(structureIsValid(tree, vrls));
+    const auto members = membersOfNodes(tree);
+    size_t partitions = 0;
+    for (size_t i = vrls.size(); i < tree.nodes().size(); ++i) {
+        if (tree.nodes()[i].vrlCount != 64) continue;
+        ++partitions;
+        const auto slab = [](uint32_t k) { return k % 2; };
+        const bool oneSlab = std::all_of(members[i].begin(), members[i].end(),
+                                         [&](uint32_t k) { return slab(k) == slab(members[i].front()); });
+        EXPECT_TRUE(oneSlab) << at(i) << "a partition mixes the two slabs";
+    }
+    EXPECT_EQ(partitions, 8u);
+}
+
+// ---------------------------------------------------------------------------
+// Quality: the hybrid build against the global agglomerative one on 5156
+// light-traced VRLs of the smoke room (800 paths, seed 3). Measured: the
+// global build costs 41277, partitionSize 2048 (4 partitions) 1.010x that,
+// partitionSize 64 (128 partitions) 1.113x; the paper reports a 25% gathering
+// overhead for its hybrid tree. Bound: 1.3x. The summed cost is dominated by
+// the few large nodes near the root, so it is a coarse check: a balanced tree
+// pairing VRLs in input order scores 1.77x, median splits down to 64 VRLs with
+// balanced pairing inside them only 1.23x. The merge rule itself is pinned
+// down by the greedy-reference tests above.
 TEST(LightTree, HybridBuildCostIsCloseToGlobalBuild) {
     const std::vector<Vrl>& vrls = smokeRoomVrls();
     ASSERT_GE(vrls.size(), 5000u);
@@ -582,7 +779,32 @@ TEST(LightTree, HybridBuildCostIsCloseToGlobalBuild) {
         const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
         std::printf("[ quality  ] partitionSize %u: cost %.6g = %.3fx global (%.3f s)\n", size, hybrid,
                     hybrid / global, seconds);
-        EXPECT_LE(hybrid, 1.5 * global) << "partitionSize " << size;
+        EXPECT_LE(hybrid, 1.3 * global) << "partitionSize " << size;
+    }
+}
+
+// ---------------------------------------------------------------------------
+// Known bug, reported, not fixed here (render/light_tree.cpp, agglomerate's
+// pushBest): a merge cost (w_a + w_b) * diagonal^2 that overflows float to
+// +inf (here finite fluxes of 1e33 W, 1 km apart) never beats the +inf that
+// marks the cluster itself, so the cluster gets no heap entry and is never
+// merged: the hybrid build returns root -1 over 4 VRLs, the global build a
+// root holding 2 of the 4. Enable once fixed.
+TEST(LightTree, DISABLED_MergeCostOverflowStillJoinsEveryVrl) {
+    std::vector<Vrl> vrls(4);
+    const float x[4] = {0.0f, 0.5f, 1000.0f, 1000.5f};
+    for (size_t i = 0; i < vrls.size(); ++i) {
+        vrls[i].origin = {x[i], 0.0f, 0.0f};
+        vrls[i].direction = {0.0f, 0.0f, 1.0f};
+        vrls[i].length = 1.0f;
+        vrls[i].flux = Rgb(1e33f);
+        vrls[i].medium = 0;
+    }
+    for (uint32_t size : {2u, kGlobal}) {
+        LightTreeSettings settings;
+        settings.partitionSize = size;
+        SCOPED_TRACE("partitionSize " + std::to_string(size));
+        expectValidTree(LightTree::build(vrls, settings), vrls);
     }
 }
 
