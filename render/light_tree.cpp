@@ -89,14 +89,14 @@ int32_t agglomerate(const std::vector<int32_t>& inputs, Lookup&& lookup, int32_t
             costs[q] = (w + weight[q]) * (dx * dx + dy * dy + dz * dz);
         }
         costs[p] = std::numeric_limits<float>::infinity();
-        size_t best = p;
+        // Start from some other live cluster: with overflowing (infinite) costs every
+        // cluster must still get a partner, or the build would stop short of a root.
+        size_t best = p == 0 ? 1 : 0;
         for (size_t q = 0; q < live; ++q) {
             if (costs[q] < costs[best]) best = q;
         }
-        if (best != p) {
-            const uint32_t other = idAt[best];
-            heap.push({costs[best], id, other, version[id], version[other]});
-        }
+        const uint32_t other = idAt[best];
+        heap.push({costs[best], id, other, version[id], version[other]});
     };
     for (uint32_t id = 0; id < n; ++id) pushBest(id);
     int32_t root = -1;
@@ -278,11 +278,22 @@ LightTree LightTree::fromParts(std::vector<Vrl> vrls, std::vector<LightTreeNode>
         const bool leaf = size_t(i) < count;
         if (leaf != n.isLeaf() || (leaf && n.right >= 0))
             throw std::invalid_argument("light tree: node " + std::to_string(i) + " has the wrong kind");
-        if (leaf) continue;
+        if (leaf) {
+            if (n.representative != uint32_t(i) || n.vrlCount != 1)
+                throw std::invalid_argument("light tree: leaf " + std::to_string(i) + " does not stand for VRL " +
+                                            std::to_string(i));
+            continue;
+        }
         for (int32_t c : {n.left, n.right}) {
             if (c < 0 || size_t(c) >= nodes.size()) throw std::invalid_argument("light tree: child index out of range");
             stack.push_back(c);
         }
+        const LightTreeNode& l = nodes[n.left];
+        const LightTreeNode& r = nodes[n.right];
+        if (n.vrlCount != l.vrlCount + r.vrlCount ||
+            (n.representative != l.representative && n.representative != r.representative))
+            throw std::invalid_argument("light tree: node " + std::to_string(i) +
+                                        " disagrees with its children (count or representative)");
     }
     if (std::find(seen.begin(), seen.end(), 0) != seen.end())
         throw std::invalid_argument("light tree: some nodes are not reachable from the root");
