@@ -23,7 +23,7 @@ double maxSubtendedAngle(double segmentLength, double h) {
 
 double distanceLineSegment(const Vec3& origin, const Vec3& direction, const Vec3& a, const Vec3& b) {
     const V3d d = toDouble(direction);
-    const V3d ra = toDouble(a - origin), ab = toDouble(b - a);
+    const V3d ra = toDouble(a) - toDouble(origin), ab = toDouble(b) - toDouble(a);
     const V3d p = ra - d * d.dot(ra), q = ab - d * d.dot(ab);  // components across the line
     const double qq = q.length2();
     const double s = qq > 0.0 ? std::clamp(-p.dot(q) / qq, 0.0, 1.0) : 0.0;
@@ -123,7 +123,12 @@ double ClusterBound::minimumDistance(int32_t index, const CameraSegment& segment
 
 Rgb ClusterBound::bound(int32_t index, const CameraSegment& segment, bool* lineCrossesNode) const {
     const LightTreeNode& node = tree_.nodes()[index];
-    const double h = minimumDistance(index, segment);
+    // The estimator's sample points are rounded to float: take h_min a few float
+    // steps of the coordinates closer, so that the bound holds through rounding.
+    const float reach = std::max({std::abs(node.box.min.x), std::abs(node.box.min.y), std::abs(node.box.min.z),
+                                  std::abs(node.box.max.x), std::abs(node.box.max.y), std::abs(node.box.max.z)});
+    const double slack = 8.0 * 0x1p-24 * (double(segment.origin.length()) + reach);
+    const double h = minimumDistance(index, segment) - slack;
     if (lineCrossesNode) *lineCrossesNode = !(h > 0.0);
     if (!(h > 0.0)) return Rgb(std::numeric_limits<float>::infinity());
     const HomogeneousMedium& cameraMedium = scene_.media()[segment.medium];
@@ -137,8 +142,10 @@ Rgb ClusterBound::bound(int32_t index, const CameraSegment& segment, bool* lineC
     // T_r(w) <= T_r(h_min) only if the segment between u and v stays in this one convex medium.
     Rgb between(1.0f);
     if (node.medium == segment.medium && cameraMedium.boundaryConvex()) between = cameraMedium.transmittance(float(h));
-    const double scale = kRoundingMargin * phase * maxSubtendedAngle(segment.length, h) * node.maxLength / h;
-    return node.clusterFlux * sigmaSV * cameraMedium.sigmaS() * segment.transmittanceBefore * between * float(scale);
+    // The node is estimated by its representative with flux Phi_C: the bound's
+    // Phi L factor is Phi_C L_rep = the node's flux x length (<= Phi_C L_max, Eq. 11's).
+    const double scale = kRoundingMargin * phase * maxSubtendedAngle(segment.length, h) / h;
+    return node.fluxLength * sigmaSV * cameraMedium.sigmaS() * segment.transmittanceBefore * between * float(scale);
 }
 
 }  // namespace vrl

@@ -11,8 +11,11 @@
 // segment (length S) subtends from a point at distance h from its line, is at
 // most 2 atan(S / (2 h)) (foot point in the middle) — the paper prints
 // 2 atan(2h/S), which is inverted: it must tend to pi as S -> infinity. So
-//   estimate <= Phi_C sigma_s(u) sigma_s(v) f^2 T_before T_r(h_min) theta_max L_max / h_min,
-// with h_min <= distance between the node's VRLs and the camera line, T_r(h_min)
+//   estimate <= Phi_C L_rep sigma_s(u) sigma_s(v) f^2 T_before T_r(h_min) theta_max / h_min,
+// where Phi_C L_rep, the node's flux x length, is tighter than Eq. 11's Phi_C L_max
+// (the representative carries the estimate) and also bounds the node's true
+// contribution; h_min <= distance between the node's VRLs and the camera line
+// (less a few float steps, for the rounding of sample points), T_r(h_min)
 // only for media whose boundary is convex (else 1), visibility and T_r(u)
 // bounded by 1. A line through the node's box (h_min = 0) gives an infinite
 // bound: the node is always refined. Henyey-Greenstein media have no such

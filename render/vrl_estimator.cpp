@@ -52,7 +52,9 @@ Equiangular equiangular(const Vec3& origin, const Vec3& direction, float length,
     const V3d w = toDouble(direction), r = toDouble(point - origin);
     const double delta = w.dot(r);
     const double distance = (r - w * delta).length();
-    const double h = std::max(distance, 1e-7 * (1.0 + r.length() + length));
+    // Floor against exact hits on the line, relative to the point's own scale (not the
+    // segment's: a ray leaving an unbounded medium is 1e30 long).
+    const double h = std::max(distance, 1e-7 * (1.0 + r.length()));
     return {delta, h, std::atan2(0.0 - delta, h), std::atan2(double(length) - delta, h)};
 }
 

@@ -12,10 +12,14 @@
 //    the cluster flux, VrlEstimator(scene, 1)). Every channel must stay below the
 //    bound: this is a deterministic inequality (up to the bound's own 1.001
 //    rounding margin), so zero violations are required, and the largest ratio
-//    estimate / bound is printed (near-tight cases, a VRL parallel to a long
-//    segment with its foot point mid-segment, come within ~1e-3 of 1).
+//    estimate / bound is printed (near-tight cases, a VRL parallel to a
+//    segment with its foot points inside it, come within ~1e-3 of 1). Media:
+//    unbounded with and without absorption, the convex cube, two media, and
+//    coordinates far from the origin; plus a deterministic tight case (parallel
+//    VRL) for segment lengths up to 1e30 and the exactly crossing case.
 // 3. Henyey-Greenstein media: the bound x (1 + epsilon) is a heuristic; the
-//    violation rate is printed and only capped loosely.
+//    violation rate is printed and only capped loosely; the factor itself is
+//    checked exactly.
 // 4. Exact minimum distances for small nodes.
 //
 // All streams have fixed seeds; sample counts are stated with each test.
@@ -32,7 +36,9 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstdint>
 #include <limits>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -416,8 +422,9 @@ struct BoundCheck {
     uint64_t floorRegimeViolations = 0;
     uint64_t triplesByKind[int(SegmentKind::Count)] = {};
     uint64_t violationsByKind[int(SegmentKind::Count)] = {};
-    double maxRatio = 0.0;  // max over channels of estimate / bound
-    std::string worst;      // the configuration of the largest ratio
+    uint64_t scaledViolations = 0;  // against bound x SamplingPlan::alsoCountAgainst
+    double maxRatio = 0.0;          // max over channels of estimate / bound
+    std::string worst;              // the configuration of the largest ratio
 };
 
 struct SamplingPlan {
@@ -432,6 +439,7 @@ struct SamplingPlan {
     ClusterBoundSettings settings;
     std::vector<int> vrlMedia{0};  // media the VRLs are drawn in
     int segmentMedium = 0;
+    double alsoCountAgainst = 0.0;  // > 0: also count violations of bound x this factor
 };
 
 std::string describe(const Vrl& v, const LightTreeNode& node, const CameraSegment& s, double h, int channel,
@@ -488,9 +496,10 @@ BoundCheck checkBound(const Scene& scene, const SamplingPlan& plan) {
                     continue;
                 }
                 if (!isBlack(e)) ++result.positive;
-                bool violated = false;
+                bool violated = false, scaledViolated = false;
                 for (int c = 0; c < 3; ++c) {
                     if (!(e[c] <= b[c])) violated = true;
+                    if (plan.alsoCountAgainst > 0.0 && !(e[c] <= b[c] * plan.alsoCountAgainst)) scaledViolated = true;
                     if (!(e[c] > 0.0f)) continue;
                     const double ratio = b[c] > 0.0f ? double(e[c]) / double(b[c]) : kInfinity;
                     if (ratio > result.maxRatio) {
@@ -499,6 +508,7 @@ BoundCheck checkBound(const Scene& scene, const SamplingPlan& plan) {
                                                 bound.minimumDistance(int32_t(n), segment), c, e[c], b[c]);
                     }
                 }
+                result.scaledViolations += scaledViolated;
                 if (violated) {
                     ++result.violations;
                     ++result.violationsByKind[int(kind)];
@@ -549,16 +559,17 @@ TEST(ClusterBound, SceneClassifiesUnboundedAndCubeMediaAsConvex) {
     EXPECT_FALSE(cube->mediumNeedsVisibility(0));
 }
 
-// 1000 trees x 16-64 VRLs (~80 nodes) x 16 segments: ~1.2e6 triples per medium (seeds
+// 2000 trees x 16-64 VRLs (~80 nodes) x 16 segments: ~2.4e6 triples per medium (seeds
 // 101, 102), VRLs within a few units of the origin, segments up to 1e4 long. Chromatic
 // sigma_s so channels differ; exact distances below 32 VRLs (the default).
 TEST(ClusterBound, BoundsIsotropicEstimateInUnboundedMedium) {
     const auto scene = unboundedScene(Rgb(0.2f, 0.5f, 1.0f), Rgb(0.0f), 0.0f);
     SamplingPlan plan;
     plan.seed = 101;
+    plan.trees = 2000;
     const BoundCheck r = checkBound(*scene, plan);
     print("isotropic, unbounded, no absorption", r);
-    EXPECT_GE(r.triples, 1'000'000u);
+    EXPECT_GE(r.triples, 2'000'000u);
     EXPECT_GT(r.positive, r.triples / 2);
     EXPECT_GT(r.crossing, 0u);
     expectNoViolation(r);
@@ -569,9 +580,10 @@ TEST(ClusterBound, BoundsIsotropicEstimateInAbsorbingUnboundedMedium) {
     const auto scene = unboundedScene(Rgb(0.2f, 0.5f, 1.0f), Rgb(0.6f, 0.05f, 0.3f), 0.0f);
     SamplingPlan plan;
     plan.seed = 102;
+    plan.trees = 2000;
     const BoundCheck r = checkBound(*scene, plan);
     print("isotropic, unbounded, absorbing", r);
-    EXPECT_GE(r.triples, 1'000'000u);
+    EXPECT_GE(r.triples, 2'000'000u);
     expectNoViolation(r);
     EXPECT_GT(r.maxRatio, 0.9);
 }
@@ -762,27 +774,70 @@ TEST(ClusterBound, ExactlyCrossingLineGivesInfiniteBound) {
     EXPECT_FALSE(crosses);
 }
 
-// HG g = 0.7 (both ends: one medium), epsilon = 1: the bound is heuristic. Seed 106,
-// 800 trees (~1e6 triples). The paper reports < 0.02% violations in its scenes; these
-// configurations are adversarial (VRLs parallel to and grazing the camera line, where
-// the forward-peaked phase product f(u) f(v) reaches ((1+g)/(1-g)^2)^2 ~ 360 times the
-// isotropic one), so only a loose 5% cap is asserted: a bound that ignored anisotropy
-// altogether, or dropped a geometric factor, fails it by far.
+// HG g = 0.7 (one medium for both ends), epsilon = 1: the bound is a heuristic. Seed
+// 106, 800 trees (~1e6 triples). The paper reports < 0.02% violations in its scenes;
+// these configurations are adversarial (VRLs parallel to or grazing the camera line,
+// where the forward-peaked product f(u) f(v) reaches ((1+g)/(1-g)^2)^2 ~ 360 times the
+// isotropic one and the estimator's 8-bin fit of it cannot follow), so the rate is
+// printed (also per segment kind, and against the bound without the (1 + epsilon)
+// factor) and only capped loosely at 5%: a bound that dropped a geometric factor or used
+// the paper's misprinted theta_max fails it by far. That the factor is applied at all is
+// checked exactly by the next test.
 TEST(ClusterBound, HenyeyGreensteinViolationRateIsSmall) {
     const auto scene = unboundedScene(Rgb(0.2f, 0.5f, 1.0f), Rgb(0.1f), 0.7f);
     SamplingPlan plan;
     plan.seed = 106;
     plan.trees = 800;
     plan.settings.anisotropyEpsilon = 1.0f;
+    plan.alsoCountAgainst = 1.0 / (1.0 + plan.settings.anisotropyEpsilon);
     const BoundCheck r = checkBound(*scene, plan);
     print("HG g=0.7, epsilon=1", r);
-    const double rate = double(r.violations) / double(r.triples);
-    std::printf("[ HG g=0.7 ] violation rate %.5f%% (%llu of %llu)\n", 100.0 * rate,
-                (unsigned long long)r.violations, (unsigned long long)r.triples);
+    const double violationRate = rate(r.violations, r.triples);
+    std::printf("[ HG g=0.7 ] violation rate %.4f%% (%llu of %llu); %.4f%% against the bound without (1 + epsilon)\n",
+                100.0 * violationRate, (unsigned long long)r.violations, (unsigned long long)r.triples,
+                100.0 * rate(r.scaledViolations, r.triples));
     EXPECT_GE(r.triples, 800'000u);
     EXPECT_EQ(r.nonFinite, 0u);
-    EXPECT_TRUE(std::isfinite(rate));
-    EXPECT_LT(rate, 0.05);
+    EXPECT_TRUE(std::isfinite(violationRate));
+    EXPECT_LT(violationRate, 0.05);
+    EXPECT_LE(r.violations, r.scaledViolations);
+}
+
+// Anisotropic media scale the isotropic bound by exactly (1 + epsilon); isotropic media
+// ignore epsilon. Same tree and segment in an isotropic and an HG medium of equal
+// coefficients (relative tolerance 1e-6: float products).
+TEST(ClusterBound, AnisotropyEpsilonScalesTheIsotropicBound) {
+    const auto isotropic = unboundedScene(Rgb(0.2f, 0.5f, 1.0f), Rgb(0.1f), 0.0f);
+    const auto hg = unboundedScene(Rgb(0.2f, 0.5f, 1.0f), Rgb(0.1f), 0.7f);
+    Rng rng(111, 0);
+    const Region region;
+    const ReferenceLine line = randomReferenceLine(rng, region);
+    std::vector<Vrl> vrls;
+    for (int i = 0; i < 40; ++i) vrls.push_back(randomVrl(rng, region, line, 0));
+    const LightTree tree = LightTree::build(vrls);
+    CameraSegment segment;  // its line z = 10 passes clear of the VRLs (|z| < 4): finite bounds
+    segment.origin = Vec3(-5.0f, 0.3f, 10.0f);
+    segment.direction = Vec3(1.0f, 0.0f, 0.0f);
+    segment.length = 20.0f;
+    segment.medium = 0;
+    segment.transmittanceBefore = Rgb(0.9f, 0.5f, 0.7f);
+    for (float epsilon : {0.0f, 1.0f, 3.0f}) {
+        ClusterBoundSettings settings;
+        settings.anisotropyEpsilon = epsilon;
+        const ClusterBound isotropicBound(*isotropic, tree, settings), hgBound(*hg, tree, settings);
+        ClusterBoundSettings zero = settings;
+        zero.anisotropyEpsilon = 0.0f;
+        const ClusterBound isotropicZero(*isotropic, tree, zero);
+        for (size_t n = 0; n < tree.nodes().size(); ++n) {
+            const Rgb bi = isotropicBound.bound(int32_t(n), segment), bh = hgBound.bound(int32_t(n), segment);
+            const Rgb b0 = isotropicZero.bound(int32_t(n), segment);
+            ASSERT_TRUE(isFinite(bi));
+            for (int c = 0; c < 3; ++c) {
+                EXPECT_EQ(bi[c], b0[c]) << "isotropic bounds do not depend on epsilon";
+                EXPECT_NEAR(bh[c], bi[c] * (1.0 + epsilon), 1e-6 * bh[c]) << "epsilon " << epsilon << " node " << n;
+            }
+        }
+    }
 }
 
 // ---- 4. Exact distances ------------------------------------------------------------------
