@@ -187,6 +187,9 @@ int runRender(const RenderCommandOptions& o) {
         std::fprintf(stderr, "  light tree %.3f s, %.1f MiB; per pixel: #Eval %.1f, #Inter %.1f, cut size %.1f\n",
                      stats.treeSeconds, double(stats.treeBytes) / (1024.0 * 1024.0), stats.meanEvaluated,
                      stats.meanIntersected, stats.meanCutSize);
+        std::fprintf(stderr, "  bound exceeded by %llu of %llu cluster estimates (%.4f%%)\n",
+                     (unsigned long long)stats.boundExceeded, (unsigned long long)stats.boundedEstimates,
+                     stats.boundedEstimates ? 100.0 * double(stats.boundExceeded) / double(stats.boundedEstimates) : 0.0);
     }
     return 0;
 }

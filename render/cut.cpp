@@ -51,6 +51,8 @@ Rgb LightcutsEstimator::estimate(const CameraSegment& segment, uint64_t streamKe
             Rng rng = vrlStream(streamKey, node.representative);
             const Rgb e = estimator_.contribution(representative, segment, rng);
             ++statistics.evaluated;
+            ++statistics.boundedEstimates;
+            if (e.x > b.x || e.y > b.y || e.z > b.z) ++statistics.boundExceeded;
             total += e;
             heap.push({luminance(b), i, e});
         }

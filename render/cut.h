@@ -27,9 +27,12 @@ struct CutStatistics {
     uint32_t evaluated = 0;    // #Eval: estimator evaluations (nodes and leaves)
     uint32_t intersected = 0;  // #Inter: nodes whose box the camera line crossed
     uint32_t cutSize = 0;      // nodes in the final cut
+    uint32_t boundExceeded = 0;  // inner-node estimates above their bound (HG media; 0 if isotropic)
+    uint32_t boundedEstimates = 0;  // inner-node estimates checked against their bound
 
     CutStatistics& operator+=(const CutStatistics& o) {
         evaluated += o.evaluated, intersected += o.intersected, cutSize += o.cutSize;
+        boundExceeded += o.boundExceeded, boundedEstimates += o.boundedEstimates;
         return *this;
     }
 };

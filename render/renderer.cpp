@@ -98,6 +98,7 @@ ImageSet renderVrl(const Scene& scene, const RenderSettings& settings, const Pro
     std::array<Image, 4> parts;
     for (auto& part : parts) part = Image(width, height);
     std::array<Image, 3> cutLayers;  // eval, inter, cut
+    std::atomic<uint64_t> boundExceeded{0}, boundedEstimates{0};
     if (lightcuts)
         for (auto& layer : cutLayers) layer = Image(width, height);
     forEachPixel(width, height, settings, progress, [&](int x, int y, Rng& rng) {
@@ -114,6 +115,8 @@ ImageSet renderVrl(const Scene& scene, const RenderSettings& settings, const Pro
             cutLayers[0].at(x, y) = Rgb(float(cut.evaluated));
             cutLayers[1].at(x, y) = Rgb(float(cut.intersected));
             cutLayers[2].at(x, y) = Rgb(float(cut.cutSize));
+            boundExceeded += cut.boundExceeded;
+            boundedEstimates += cut.boundedEstimates;
         }
     });
     ImageSet result;
@@ -131,6 +134,8 @@ ImageSet renderVrl(const Scene& scene, const RenderSettings& settings, const Pro
         statistics.meanEvaluated = sums[0] / n;
         statistics.meanIntersected = sums[1] / n;
         statistics.meanCutSize = sums[2] / n;
+        statistics.boundExceeded = boundExceeded.load();
+        statistics.boundedEstimates = boundedEstimates.load();
         const char* names[] = {"eval", "inter", "cut"};
         for (size_t l = 0; l < 3; ++l) result.layers.emplace_back(names[l], std::move(cutLayers[l]));
     }

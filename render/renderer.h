@@ -51,6 +51,7 @@ struct RenderStatistics {
     double treeSeconds = 0.0;
     size_t treeBytes = 0;
     double meanEvaluated = 0.0, meanIntersected = 0.0, meanCutSize = 0.0;  // per pixel
+    uint64_t boundExceeded = 0, boundedEstimates = 0;  // inner-node estimates above their bound
 };
 
 // Called from worker threads with the fraction done of a phase ("light tracing",
