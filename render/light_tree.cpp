@@ -8,7 +8,6 @@
 #include <algorithm>
 #include <limits>
 #include <numeric>
-#include <queue>
 #include <stdexcept>
 #include <string>
 
@@ -43,12 +42,18 @@ LightTreeNode joinNodes(const LightTreeNode& a, int32_t aIndex, const LightTreeN
     return n;
 }
 
-// Heap-based agglomerative clustering (Walter et al. 2008) of `inputs` (node
-// indices), appending inner nodes to `out`. Nodes are looked up via
-// `lookup(index)`; new nodes get indices `firstNewIndex + k`. Returns the root.
-// Clusters have stable ids (heap entries name ids and their versions); their
-// boxes and weights live in dense structure-of-arrays over the live clusters
-// only, so each best-partner scan is one branch-free, vectorisable pass.
+// Agglomerative clustering (Walter et al. 2008's greedy rule: always merge the
+// pair of least cost) of `inputs` (node indices), appending inner nodes to `out`.
+// Nodes are looked up via `lookup(index)`; new nodes get indices
+// `firstNewIndex + k`. Returns the root.
+//
+// The cost (I_a + I_b) diag(a u b)^2 is reducible: a merged cluster costs at least
+// as much with any third cluster as either part did. So the nearest-neighbour
+// chain algorithm yields exactly the greedy hierarchy, with about 2-3 best-partner
+// scans per cluster instead of a heap's repeated rescans of stale entries.
+// Clusters have stable ids; their boxes and weights live in dense
+// structure-of-arrays over the live clusters, so each scan is one branch-free,
+// vectorised pass.
 template <class Lookup>
 int32_t agglomerate(const std::vector<int32_t>& inputs, Lookup&& lookup, int32_t firstNewIndex,
                     std::vector<LightTreeNode>& out, const std::vector<Vrl>& vrls, uint64_t seed) {
@@ -56,9 +61,9 @@ int32_t agglomerate(const std::vector<int32_t>& inputs, Lookup&& lookup, int32_t
     if (n == 0) return -1;
     if (n == 1) return inputs[0];
     std::vector<float> minX(n), minY(n), minZ(n), maxX(n), maxY(n), maxZ(n), weight(n), costs(n);
-    std::vector<uint32_t> idAt(n), positionOf(n), version(n, 0);
+    std::vector<uint32_t> idAt(n), positionOf(n);
     std::vector<int32_t> node(inputs);  // by id
-    std::vector<char> alive(n, 1);      // by id
+    std::vector<char> inChain(n, 0);    // by id
     size_t live = n;
     const auto load = [&](size_t pos, const LightTreeNode& c) {
         minX[pos] = c.box.min.x, minY[pos] = c.box.min.y, minZ[pos] = c.box.min.z;
@@ -69,17 +74,9 @@ int32_t agglomerate(const std::vector<int32_t>& inputs, Lookup&& lookup, int32_t
         idAt[i] = positionOf[i] = uint32_t(i);
         load(i, lookup(node[i]));
     }
-    struct Candidate {
-        float cost;
-        uint32_t i, j, versionI, versionJ;
-        bool operator>(const Candidate& o) const {
-            if (cost != o.cost) return cost > o.cost;
-            return i != o.i ? i > o.i : j > o.j;
-        }
-    };
-    std::priority_queue<Candidate, std::vector<Candidate>, std::greater<>> heap;
-    const auto pushBest = [&](uint32_t id) {
-        const size_t p = positionOf[id];
+    // Position of the least-cost partner of the cluster at position p; ties go to
+    // `preferred` (the previous chain element), which guarantees termination.
+    const auto nearest = [&](size_t p, size_t preferred) {
         const float ax0 = minX[p], ay0 = minY[p], az0 = minZ[p], ax1 = maxX[p], ay1 = maxY[p], az1 = maxZ[p];
         const float w = weight[p];
         for (size_t q = 0; q < live; ++q) {
@@ -89,33 +86,43 @@ int32_t agglomerate(const std::vector<int32_t>& inputs, Lookup&& lookup, int32_t
             costs[q] = (w + weight[q]) * (dx * dx + dy * dy + dz * dz);
         }
         costs[p] = std::numeric_limits<float>::infinity();
-        // Start from some other live cluster: with overflowing (infinite) costs every
-        // cluster must still get a partner, or the build would stop short of a root.
-        size_t best = p == 0 ? 1 : 0;
+        // Start from another live cluster: with overflowing (infinite) costs every
+        // cluster must still get a partner.
+        size_t best = preferred < live ? preferred : (p == 0 ? 1 : 0);
         for (size_t q = 0; q < live; ++q) {
             if (costs[q] < costs[best]) best = q;
         }
-        const uint32_t other = idAt[best];
-        heap.push({costs[best], id, other, version[id], version[other]});
+        return best;
     };
-    for (uint32_t id = 0; id < n; ++id) pushBest(id);
+    std::vector<uint32_t> chain;
     int32_t root = -1;
-    while (live > 1 && !heap.empty()) {
-        const Candidate top = heap.top();
-        heap.pop();
-        if (!alive[top.i] || top.versionI != version[top.i]) continue;  // i has a fresher entry
-        if (!alive[top.j] || top.versionJ != version[top.j]) {
-            pushBest(top.i);  // partner gone or grown: find a new one
+    while (live > 1) {
+        if (chain.empty()) {
+            chain.push_back(idAt[0]);
+            inChain[idAt[0]] = 1;
+        }
+        const uint32_t a = chain.back();
+        const uint32_t previous = chain.size() >= 2 ? chain[chain.size() - 2] : uint32_t(n);
+        const size_t preferred = previous < n ? positionOf[previous] : size_t(-1);
+        const uint32_t b = idAt[nearest(positionOf[a], preferred)];
+        if (b != previous && !inChain[b]) {  // (inChain[b]: only with NaN costs; merge instead of cycling)
+            chain.push_back(b);
+            inChain[b] = 1;
             continue;
         }
+        const uint32_t partner = previous < n ? previous : b;
+        // Merge a and its partner: the result keeps id a, the partner's slot is refilled.
+        chain.pop_back();
+        inChain[a] = 0;
+        if (partner == previous) {
+            chain.pop_back();
+            inChain[partner] = 0;
+        }
         const int32_t index = firstNewIndex + int32_t(out.size());
-        out.push_back(joinNodes(lookup(node[top.i]), node[top.i], lookup(node[top.j]), node[top.j], vrls, seed));
-        node[top.i] = index;
-        ++version[top.i];
-        load(positionOf[top.i], out.back());
-        // Remove j: the last live cluster takes its place.
-        alive[top.j] = 0;
-        const size_t hole = positionOf[top.j], last = live - 1;
+        out.push_back(joinNodes(lookup(node[a]), node[a], lookup(node[partner]), node[partner], vrls, seed));
+        node[a] = index;
+        load(positionOf[a], out.back());
+        const size_t hole = positionOf[partner], last = live - 1;
         if (hole != last) {
             const uint32_t moved = idAt[last];
             minX[hole] = minX[last], minY[hole] = minY[last], minZ[hole] = minZ[last];
@@ -126,7 +133,6 @@ int32_t agglomerate(const std::vector<int32_t>& inputs, Lookup&& lookup, int32_t
         }
         --live;
         root = index;
-        if (live > 1) pushBest(top.i);
     }
     return root;
 }
