@@ -215,7 +215,13 @@ void registerRenderCommand(CLI::App& app, int& exitCode) {
     cmd->add_option("--max-depth", o->maxDepth,
                     "Path length as Mitsuba's maxDepth: 1 emitters only, 2 direct + single scattering, -1 unlimited "
                     "(default: the scene's integrator)")
-        ->check(CLI::Range(-1, 100000));
+        ->check(CLI::Validator(
+            [](std::string& value) {
+                const int depth = std::atoi(value.c_str());
+                return depth == -1 || (depth >= 1 && depth <= 100000) ? std::string()
+                                                                     : std::string("must be -1 or 1..100000");
+            },
+            "-1 or 1..100000"));
     cmd->add_option("--vrls", o->vrls, "vrl: target number of VRLs; whole light paths are traced until reached")
         ->check(CLI::Range(uint64_t(1), uint64_t(1) << 32));
     cmd->add_option("--light-paths", o->lightPaths, "vrl: trace exactly this many light paths (overrides --vrls)")

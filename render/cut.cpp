@@ -2,6 +2,7 @@
 
 #include "render/scene.h"
 
+#include <limits>
 #include <queue>
 #include <vector>
 
@@ -54,7 +55,8 @@ Rgb LightcutsEstimator::estimate(const CameraSegment& segment, uint64_t streamKe
             ++statistics.boundedEstimates;
             if (e.x > b.x || e.y > b.y || e.z > b.z) ++statistics.boundExceeded;
             total += e;
-            heap.push({luminance(b), i, e});
+            const float key = luminance(b);
+            heap.push({key >= 0.0f ? key : std::numeric_limits<float>::infinity(), i, e});  // NaN: refine
         }
     };
 

@@ -26,10 +26,16 @@ struct Ray {
     Vec3 direction;
     float tMax = kInfinity;
     float tMin = 0.0f;
-    // Hits on shape `skipShape` closer than `skipUntil` are ignored: the surface the
-    // ray just crossed. Any other surface at the same distance is still found.
-    static constexpr uint32_t kNoShape = ~0u;
-    uint32_t skipShape = kNoShape;
+    // Hits closer than `skipUntil` on the triangles (shape, triangle) in
+    // skip[0, skipCount) are ignored: the surfaces the ray just crossed (several when
+    // boundaries coincide or the crossing is on a shared edge). Any other surface at
+    // the same distance, including another part of the same shape, is still found.
+    static constexpr int kMaxSkipped = 6;
+    struct Crossed {
+        uint32_t shape, triangle;
+    };
+    Crossed skip[kMaxSkipped] = {};
+    int skipCount = 0;
     float skipUntil = 0.0f;
 
     Vec3 at(float t) const { return origin + direction * t; }

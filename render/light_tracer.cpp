@@ -45,6 +45,7 @@ public:
         int medium = emitter.medium;
         int vertices = 0;  // real scattering vertices so far; the current segment is number vertices + 1
         float segmentStart = 0.0f;
+        int mediumBeforeCrossing = medium;  // before the last null boundary crossed
         const auto keepsVrls = [&] { return settings_.maxDepth < 0 || vertices + 3 <= settings_.maxDepth; };
         const auto roulette = [&] {
             if (vertices < settings_.rouletteDepth) return true;
@@ -97,22 +98,29 @@ public:
             if (!hit || isBlack(throughput)) return;
             const SceneShape& shape = scene_.shapes()[hit->shape];
             if (shape.bsdf.isNull()) {
+                if (!Scene::withinCrossing(ray, *hit)) mediumBeforeCrossing = medium;
                 medium = scene_.mediumAfter(*hit, ray.direction, medium);
                 segmentStart = hit->t;
                 Scene::continuePast(ray, *hit);
                 continue;
             }
-            // Diffuse bounce about the geometric normal: the cosine-sampled weight is
-            // then exactly the albedo (shading normals would need the adjoint correction).
+            if (Scene::withinCrossing(ray, *hit)) medium = mediumBeforeCrossing;
+            // Diffuse bounce sampled about the geometric normal. The camera side shades
+            // with the shading normal, f cos_s(wi); as an adjoint the light path carries
+            // albedo x cos_s(wi) / cos_g(wi) (Veach 1997, wi towards the light).
             Vec3 n = hit->geometricNormal;
+            Vec3 shadingNormal = hit->shadingNormal;
             const bool front = ray.direction.dot(hit->geometricNormal) < 0.0f;
             if (!front) {
                 if (!shape.bsdf.twoSided) return;
                 n = -n;
+                shadingNormal = -shadingNormal;
             }
+            const float cosShading = -ray.direction.dot(shadingNormal), cosGeometric = -ray.direction.dot(n);
+            if (!(cosShading > 0.0f) || !(cosGeometric > 0.0f)) return;
             ++vertices;
             const Vec3 dir = Frame::fromNormal(n).toWorld(cosineHemisphere(Vec2(rng.next(), rng.next()))).normalized();
-            throughput *= shape.bsdf.reflectance;
+            throughput *= shape.bsdf.reflectance * (cosShading / cosGeometric);
             medium = scene_.mediumAfter(*hit, dir, medium);
             ray = Ray{Scene::offsetOrigin(*hit, dir), dir};
             segmentStart = 0.0f;

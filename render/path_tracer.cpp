@@ -43,6 +43,7 @@ Rgb VolumetricPathTracer::radiance(Ray ray, int medium, Rng& rng, const PathStar
     const auto counts = [&] { return !restricted || vertices >= 2; };
 
     float segmentStart = ray.tMin;  // where the ray entered its current medium
+    int mediumBeforeCrossing = medium;  // before the last null boundary crossed
     for (int steps = 0; steps < 100000; ++steps) {
         const auto hit = scene_.intersect(ray);
         const float tSurface = hit ? hit->t : ray.tMax;
@@ -81,12 +82,14 @@ Rgb VolumetricPathTracer::radiance(Ray ray, int medium, Rng& rng, const PathStar
             result += throughput * scene_.emitters()[shape.emitter]->emittedRadiance(hit->geometricNormal, -ray.direction);
 
         if (shape.bsdf.isNull()) {
+            if (!Scene::withinCrossing(ray, *hit)) mediumBeforeCrossing = medium;
             medium = scene_.mediumAfter(*hit, ray.direction, medium);
             segmentStart = hit->t;
             Scene::continuePast(ray, *hit);  // same ray: distances stay exact
             continue;
         }
         firstSegment = false;
+        if (Scene::withinCrossing(ray, *hit)) medium = mediumBeforeCrossing;
         if (restricted && vertices + 1 <= 2) break;  // a surface among the first two vertices
 
         // Diffuse reflection on the side the ray arrived from.

@@ -26,20 +26,22 @@ struct Scene::Embree {
 
 namespace {
 
-// Embree context carrying the shape a continued ray must ignore (Ray::skipShape).
+constexpr int kLocateMedium = -2;  // placeholder until the BVH can locate an emitter's medium
+
+// Embree context carrying the triangles a continued ray must ignore (Ray::skip).
 struct SkipContext {
     RTCIntersectContext context;
-    uint32_t skipShape;
-    float skipUntil;
+    const Ray* ray;
 };
 
 void skipCrossedShape(const RTCFilterFunctionNArguments* args) {
-    const auto* skip = reinterpret_cast<const SkipContext*>(args->context);
+    const Ray& ray = *reinterpret_cast<const SkipContext*>(args->context)->ray;
     for (unsigned i = 0; i < args->N; ++i) {
-        if (args->valid[i] == 0) continue;
-        if (RTCHitN_geomID(args->hit, args->N, i) == skip->skipShape &&
-            RTCRayN_tfar(args->ray, args->N, i) < skip->skipUntil)
-            args->valid[i] = 0;
+        if (args->valid[i] == 0 || !(RTCRayN_tfar(args->ray, args->N, i) < ray.skipUntil)) continue;
+        const uint32_t shape = RTCHitN_geomID(args->hit, args->N, i), triangle = RTCHitN_primID(args->hit, args->N, i);
+        for (int k = 0; k < ray.skipCount; ++k) {
+            if (ray.skip[k].shape == shape && ray.skip[k].triangle == triangle) args->valid[i] = 0;
+        }
     }
 }
 
@@ -127,10 +129,9 @@ std::unique_ptr<Scene> Scene::build(const SceneDescription& description) {
         const auto& radiance = description.shapes[i].areaRadiance;
         if (!radiance || isBlack(*radiance)) continue;
         auto emitter = makeAreaEmitter(scene->shapes_[i].mesh, *radiance);
-        // The side it emits into; a shape that declares no media sits in the camera's (ambient) medium.
+        // The side it emits into; a shape that declares no media is located after the BVH is built.
         const auto& shape = description.shapes[i];
-        emitter->medium = shape.interiorMedium >= 0 || shape.exteriorMedium >= 0 ? shape.exteriorMedium
-                                                                                 : description.sensor.medium;
+        emitter->medium = shape.interiorMedium >= 0 || shape.exteriorMedium >= 0 ? shape.exteriorMedium : kLocateMedium;
         scene->shapes_[i].emitter = int(scene->emitters_.size());
         scene->emitters_.push_back(std::move(emitter));
     }
@@ -141,7 +142,7 @@ std::unique_ptr<Scene> Scene::build(const SceneDescription& description) {
             emitter = makePointEmitter(e.toWorld.applyPoint(Vec3(0.0f)), e.intensity);
         else
             emitter = makeSpotEmitter(e.toWorld, e.intensity, e.cutoffAngle, e.beamWidth);
-        emitter->medium = e.medium >= 0 ? e.medium : description.sensor.medium;
+        emitter->medium = e.medium >= 0 ? e.medium : kLocateMedium;
         scene->emitters_.push_back(std::move(emitter));
     }
     if (scene->emitters_.empty()) spdlog::warn("{}: the scene has no emitters; the image will be black", description.file.string());
@@ -150,6 +151,16 @@ std::unique_ptr<Scene> Scene::build(const SceneDescription& description) {
     scene->emitterSampler_ = std::make_unique<EmitterSampler>(emitters);
     scene->classifyMediumBoundaries();
     scene->buildBvh();
+    // Emitters that declare no medium: the one reached by walking from the camera
+    // to them through the declared boundaries (light tracing starts there).
+    for (size_t k = 0; k < scene->emitters_.size(); ++k) {
+        Emitter& emitter = *scene->emitters_[k];
+        if (emitter.medium != kLocateMedium) continue;
+        const EmissionSample probe = emitter.sampleEmission(Vec2(0.5f, 0.5f), Vec2(0.0f, 0.0f));
+        const Vec3& p = probe.ray.origin;
+        const float step = 1e-4f * (1.0f + std::max({std::abs(p.x), std::abs(p.y), std::abs(p.z)}));
+        emitter.medium = scene->mediumAt(p + probe.ray.direction * step);
+    }
     return scene;
 }
 
@@ -209,7 +220,10 @@ void Scene::buildBvh() {
         auto* indices = static_cast<uint32_t*>(rtcSetNewGeometryBuffer(geometry, RTC_BUFFER_TYPE_INDEX, 0,
                                                                        RTC_FORMAT_UINT3, 3 * sizeof(uint32_t),
                                                                        mesh.triangles.size()));
-        if (!vertices || !indices) throw std::runtime_error("Embree could not allocate geometry buffers: " + embree_->firstError);
+        if (!vertices || !indices) {
+            rtcReleaseGeometry(geometry);
+            throw std::runtime_error("Embree could not allocate geometry buffers: " + embree_->firstError);
+        }
         for (size_t v = 0; v < mesh.positions.size(); ++v) {
             vertices[3 * v] = mesh.positions[v].x;
             vertices[3 * v + 1] = mesh.positions[v].y;
@@ -229,10 +243,9 @@ std::optional<SurfaceHit> Scene::intersect(const Ray& ray) const {
     if (shapes_.empty()) return std::nullopt;
     SkipContext skip{};
     rtcInitIntersectContext(&skip.context);
-    if (ray.skipShape != Ray::kNoShape) {
+    if (ray.skipCount > 0) {
         skip.context.filter = skipCrossedShape;
-        skip.skipShape = ray.skipShape;
-        skip.skipUntil = ray.skipUntil;
+        skip.ray = &ray;
     }
     RTCRayHit rayHit{};
     rayHit.ray.org_x = ray.origin.x;
@@ -289,21 +302,48 @@ Vec3 Scene::offsetOrigin(const SurfaceHit& hit, const Vec3& direction) {
 void Scene::continuePast(Ray& ray, const SurfaceHit& hit) {
     const Vec3& p = hit.position;
     const float scale = 1.0f + std::max({std::abs(p.x), std::abs(p.y), std::abs(p.z)});
-    const float cosine = std::max(std::abs(ray.direction.dot(hit.geometricNormal)), 1e-3f);
+    // Grazing hits widen the window only so far.
+    const float cosine = std::max(std::abs(ray.direction.dot(hit.geometricNormal)), 0.1f);
     // Float noise around the crossing: a surface coinciding with the one crossed
     // (an opaque wall flush with a medium's boundary) is still found, and the
-    // crossed shape is ignored until past it (a hit on a shared edge reports both
-    // of its triangles).
+    // crossed triangle is ignored until past it (mediumAfter makes a repeated
+    // crossing, e.g. of the neighbour on a shared edge, harmless).
     const float noise = 1e-5f * scale / cosine;
+    // Coinciding boundaries (two media sharing a face) or a shared edge: keep skipping
+    // everything crossed at this spot, or the ray would bounce between them.
+    if (ray.skipCount > 0 && hit.t < ray.skipUntil && ray.skipCount < Ray::kMaxSkipped) {
+        ray.skip[ray.skipCount++] = {hit.shape, hit.triangle};
+    } else {
+        ray.skip[0] = {hit.shape, hit.triangle};
+        ray.skipCount = 1;
+    }
     ray.tMin = std::max(0.0f, hit.t - noise);
-    ray.skipShape = hit.shape;
     ray.skipUntil = hit.t + noise;
 }
 
 int Scene::mediumAfter(const SurfaceHit& hit, const Vec3& direction, int currentMedium) const {
     const SceneShape& shape = shapes_[hit.shape];
     if (!shape.changesMedium) return currentMedium;
-    return direction.dot(hit.geometricNormal) < 0.0f ? shape.interiorMedium : shape.exteriorMedium;
+    if (direction.dot(hit.geometricNormal) < 0.0f) return shape.interiorMedium;  // entering
+    // Leaving: only from its own interior. A ray already in another medium crossed a
+    // coinciding boundary first (or crosses this one twice at a shared edge): keep it.
+    return currentMedium == shape.interiorMedium ? shape.exteriorMedium : currentMedium;
+}
+
+int Scene::mediumAt(const Vec3& point) const {
+    int medium = description_.sensor.medium;
+    const Vec3 from = camera_.position();
+    const Vec3 d = point - from;
+    const float distance = d.length();
+    if (!(distance > 0.0f)) return medium;
+    Ray ray{from, d / distance, distance};
+    for (int crossings = 0; crossings < 4096; ++crossings) {
+        const auto hit = intersect(ray);
+        if (!hit) return medium;
+        medium = mediumAfter(*hit, ray.direction, medium);
+        continuePast(ray, *hit);
+    }
+    return medium;
 }
 
 Rgb Scene::transmittance(const Vec3& from, const Vec3& to, int medium) const {

@@ -65,6 +65,9 @@ public:
     // Transmittance from `from` (in medium `medium`) to `to`, passing through null
     // boundaries (switching media) and returning zero at any other surface.
     Rgb transmittance(const Vec3& from, const Vec3& to, int medium) const;
+    // The medium at `point`, found by walking from the camera through the declared
+    // media boundaries (the camera's medium if none is crossed).
+    int mediumAt(const Vec3& point) const;
     // The medium on the side of `shape` that `direction` points into from `hit`.
     int mediumAfter(const SurfaceHit& hit, const Vec3& direction, int currentMedium) const;
 
@@ -73,6 +76,13 @@ public:
     // Continues `ray` past the surface it hit at `hit` (crossing a null boundary):
     // the same ray from the hit distance on, ignoring only that shape there.
     static void continuePast(Ray& ray, const SurfaceHit& hit);
+    // True if `hit` lies within the crossing window of the null boundary `ray` just
+    // crossed: a surface flush with that boundary (a medium box resting on a floor).
+    // Such a surface is met from the side the ray came from: use the medium from
+    // before the crossing.
+    static bool withinCrossing(const Ray& ray, const SurfaceHit& hit) {
+        return ray.skipCount > 0 && hit.t < ray.skipUntil;
+    }
 
 private:
     Scene(const SceneDescription& description);

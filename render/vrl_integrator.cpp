@@ -55,19 +55,22 @@ Rgb VrlIntegrator::singleScattering(const CameraSegment& segment, Rng& rng) cons
 Rgb VrlIntegrator::mediumToSurface(const CameraSegment& segment, Rng& rng) const {
     if (settings_.maxDepth >= 0 && settings_.maxDepth < 3) return Rgb(0.0f);
     const HomogeneousMedium& medium = scene_.media()[segment.medium];
-    // u in proportion to exp(-sigma u) on [0, length], sigma the mean extinction.
-    const double sigma = average(medium.sigmaT()), length = segment.length;
-    const double xi = rng.next();
-    double u, pdf;
-    if (sigma * length < 1e-6) {
-        u = xi * length;
-        pdf = 1.0 / length;
-    } else {
-        const double mass = -std::expm1(-sigma * length);
-        u = std::min(length, -std::log1p(-xi * mass) / sigma);
-        pdf = sigma * std::exp(-sigma * u) / mass;
-    }
-    if (!(pdf > 0.0)) return Rgb(0.0f);
+    // u on [0, length] from one channel's truncated exponential, chosen uniformly;
+    // the pdf is the average over channels (spectral MIS), so no channel's
+    // transmittance outruns its density in chromatic media.
+    const double length = segment.length;
+    const auto truncatedPdf = [&](double sigma, double u) {
+        if (sigma * length < 1e-6) return 1.0 / length;
+        return sigma * std::exp(-sigma * u) / -std::expm1(-sigma * length);
+    };
+    const int channel = std::min(2, int(rng.next() * 3.0f));
+    const double sigmaChannel = medium.sigmaT()[channel], xi = rng.next();
+    const double u = sigmaChannel * length < 1e-6
+                         ? xi * length
+                         : std::min(length, -std::log1p(xi * std::expm1(-sigmaChannel * length)) / sigmaChannel);
+    double pdf = 0.0;
+    for (int c = 0; c < 3; ++c) pdf += truncatedPdf(medium.sigmaT()[c], u) / 3.0;
+    if (!(pdf > 0.0) || !std::isfinite(pdf)) return Rgb(0.0f);
     const Vec3 x = segment.origin + segment.direction * float(u);
     const PhaseSample next = medium.phase().sample(segment.direction, Vec2(rng.next(), rng.next()));
     // Exact transmittance to the next surface, reflected light only: a path that
