@@ -71,7 +71,9 @@ int main(int argc, char** argv) {
     uint64_t globalMax = 100000;
     uint64_t strideAbove = 200000;
     int stride = 4;
+    std::vector<std::string> defines;
     app.add_option("--scene", scenePath, "Scene file (default scenes/smoke-room.xml)");
+    app.add_option("-D,--define", defines, "Override a scene <default>: -D name=value (repeatable)");
     app.add_option("--vrls", counts, "VRL counts to run (default 10000 100000 1000000)");
     app.add_option("--resolution", resolution, "Image size WxH for shading (default 64x48)");
     app.add_option("--error", error, "Lightcuts error threshold (default 0.02)");
@@ -80,7 +82,16 @@ int main(int argc, char** argv) {
     app.add_option("--stride", stride, "Pixel stride for large N (default 4: 1/16 of the pixels)");
     CLI11_PARSE(app, argc, argv);
 
-    SceneDescription description = parseMitsubaScene(scenePath);
+    ParseOptions parseOptions;
+    for (const auto& d : defines) {
+        const auto eq = d.find('=');
+        if (eq == std::string::npos) {
+            std::fprintf(stderr, "-D expects name=value, got '%s'\n", d.c_str());
+            return 2;
+        }
+        parseOptions.defines[d.substr(0, eq)] = d.substr(eq + 1);
+    }
+    SceneDescription description = parseMitsubaScene(scenePath, parseOptions);
     int w = 0, h = 0;
     if (std::sscanf(resolution.c_str(), "%dx%d", &w, &h) != 2 || w < 1 || h < 1) {
         std::fprintf(stderr, "bad --resolution '%s'\n", resolution.c_str());
@@ -89,7 +100,10 @@ int main(int argc, char** argv) {
     description.sensor.width = w;
     description.sensor.height = h;
     const auto scene = Scene::build(description);
-    std::printf("scene %s, %dx%d, error threshold %.3f, part (d) only\n", scenePath.c_str(), w, h, error);
+    std::string defined;
+    for (const auto& d : defines) defined += " -D " + d;
+    std::printf("scene %s%s, %dx%d, error threshold %.3f, part (d) only\n", scenePath.c_str(), defined.c_str(), w, h,
+                error);
     std::printf("%9s %8s %9s %8s %9s %10s %9s %9s %8s %9s %8s %8s %8s\n", "VRLs", "trace_s", "build_s", "tree_MB",
                 "global_s", "gatherX", "plain_s", "cuts_s", "speedup", "relRMSE", "#Eval", "#Inter", "cut");
     for (uint64_t n : counts) {
