@@ -75,28 +75,17 @@ ClusterBound::ClusterBound(const Scene& scene, const LightTree& tree, ClusterBou
     firstLeaf_.assign(nodes.size(), 0);
     leafStart_.reserve(tree.vrls().size());
     leafEnd_.reserve(tree.vrls().size());
-    std::vector<int32_t> stack{tree.root()};
-    while (!stack.empty()) {  // depth first, left before right
-        const int32_t i = stack.back();
-        stack.pop_back();
-        if (nodes[i].isLeaf()) {
-            const Vrl& v = tree.vrls()[nodes[i].representative];
-            leafStart_.push_back(v.origin);
-            leafEnd_.push_back(v.end());
-            continue;
-        }
-        stack.push_back(nodes[i].right);
-        stack.push_back(nodes[i].left);
-    }
-    // A node's first leaf is its left-most descendant's position: fill bottom-up
-    // by a second walk in the same order.
-    uint32_t next = 0;
+    // Post-order walk, left before right: leaves append their endpoints; an inner
+    // node's first leaf is its left child's.
     std::vector<std::pair<int32_t, bool>> walk{{tree.root(), false}};
     while (!walk.empty()) {
         auto [i, visited] = walk.back();
         walk.pop_back();
         if (nodes[i].isLeaf()) {
-            firstLeaf_[i] = next++;
+            const Vrl& v = tree.vrls()[nodes[i].representative];
+            firstLeaf_[i] = uint32_t(leafStart_.size());
+            leafStart_.push_back(v.origin);
+            leafEnd_.push_back(v.end());
             continue;
         }
         if (!visited) {

@@ -1,5 +1,7 @@
 #include "render/emitter.h"
 
+#include "render/sampling.h"
+
 #include <algorithm>
 #include <cmath>
 #include <numeric>
@@ -7,11 +9,6 @@
 namespace vrl {
 
 namespace {
-
-Vec3 uniformSphere(const Vec2& u) {
-    const float z = 1.0f - 2.0f * u.x;
-    return sphericalDirection(std::sqrt(std::max(0.0f, 1.0f - z * z)), z, 2.0f * kPi * u.y);
-}
 
 class PointEmitter final : public Emitter {
 public:
@@ -109,9 +106,7 @@ public:
     EmissionSample sampleEmission(const Vec2& uPosition, const Vec2& uDirection) const override {
         const auto [p, n] = samplePoint(uPosition);
         // Cosine-weighted hemisphere around n: weight = Le cos / (cos/pi * 1/area).
-        const float r = std::sqrt(uDirection.x), phi = 2.0f * kPi * uDirection.y;
-        const Vec3 local(r * std::cos(phi), r * std::sin(phi), std::sqrt(std::max(0.0f, 1.0f - uDirection.x)));
-        return {Ray{p, Frame::fromNormal(n).toWorld(local).normalized()}, radiance_ * (kPi * area_)};
+        return {Ray{p, Frame::fromNormal(n).toWorld(cosineHemisphere(uDirection)).normalized()}, radiance_ * (kPi * area_)};
     }
 
 private:

@@ -4,6 +4,7 @@
 
 #include <Imath/ImathVec.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <limits>
@@ -55,6 +56,12 @@ struct Frame {
     Vec3 toWorld(const Vec3& local) const { return s * local.x + t * local.y + n * local.z; }
     Vec3 toLocal(const Vec3& world) const { return {s.dot(world), t.dot(world), n.dot(world)}; }
 };
+
+// Scale of a position's float rounding noise (1 + its largest coordinate): offsets
+// that step past a surface are multiples of it.
+inline float positionScale(const Vec3& p) {
+    return 1.0f + std::max({std::abs(p.x), std::abs(p.y), std::abs(p.z)});
+}
 
 // Unit vector from spherical coordinates around +z.
 inline Vec3 sphericalDirection(float sinTheta, float cosTheta, float phi) {

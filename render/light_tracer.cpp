@@ -1,6 +1,7 @@
 #include "render/light_tracer.h"
 
 #include "render/rng.h"
+#include "render/sampling.h"
 
 #include <spdlog/spdlog.h>
 #include <tbb/parallel_for.h>
@@ -16,11 +17,6 @@ namespace {
 
 constexpr uint64_t kPathsPerChunk = 64;
 constexpr uint64_t kChunksPerBatch = 32;
-
-Vec3 cosineHemisphere(const Vec2& u) {
-    const float r = std::sqrt(u.x), phi = 2.0f * kPi * u.y;
-    return {r * std::cos(phi), r * std::sin(phi), std::sqrt(std::max(0.0f, 1.0f - u.x))};
-}
 
 class LightPathTracer {
 public:
@@ -41,7 +37,7 @@ public:
 
         Ray ray = emission.ray;
         const Vec3& p = ray.origin;
-        ray.tMin = 1e-4f * (1.0f + std::max({std::abs(p.x), std::abs(p.y), std::abs(p.z)}));  // leave the emitter
+        ray.tMin = 1e-4f * positionScale(p);  // leave the emitter
         int medium = emitter.medium;
         int vertices = 0;  // real scattering vertices so far; the current segment is number vertices + 1
         float segmentStart = 0.0f;

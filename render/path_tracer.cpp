@@ -1,5 +1,7 @@
 #include "render/path_tracer.h"
 
+#include "render/sampling.h"
+
 #include <algorithm>
 #include <cmath>
 
@@ -24,11 +26,6 @@ DirectLighting sampleDirectLighting(const Scene& scene, const Vec3& point, const
 }
 
 namespace {
-
-Vec3 cosineHemisphere(const Vec2& u) {
-    const float r = std::sqrt(u.x), phi = 2.0f * kPi * u.y;
-    return {r * std::cos(phi), r * std::sin(phi), std::sqrt(std::max(0.0f, 1.0f - u.x))};
-}
 
 }  // namespace
 

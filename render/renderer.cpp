@@ -84,7 +84,9 @@ ImageSet renderVrl(const Scene& scene, const RenderSettings& settings, const Pro
     if (lightcuts && !vrls.vrls.empty()) {
         if (progress) progress("building the light tree", 0.0);
         const auto treeStart = std::chrono::steady_clock::now();
-        tree = LightTree::build(vrls.vrls, LightTreeSettings{settings.partitionSize, settings.seed});
+        // The tree takes the VRLs over: shading reads them from it.
+        tree = LightTree::build(std::move(vrls.vrls), LightTreeSettings{settings.partitionSize, settings.seed});
+        vrls.vrls = {};
         statistics.treeSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - treeStart).count();
         statistics.treeBytes = tree.memoryBytes();
         if (progress) progress("building the light tree", 1.0);

@@ -82,8 +82,7 @@ bool isConvexClosed(const std::vector<const TriangleMesh*>& meshes) {
             const Vec3 p0 = m->positions[m->triangles[i][0]];
             for (const auto* other : meshes) {
                 for (const Vec3& p : other->positions) {
-                    const float scale = 1.0f + std::max({std::abs(p.x), std::abs(p.y), std::abs(p.z)});
-                    if (n.dot(p - p0) > 1e-4f * scale) return false;
+                    if (n.dot(p - p0) > 1e-4f * positionScale(p)) return false;
                 }
             }
         }
@@ -158,7 +157,7 @@ std::unique_ptr<Scene> Scene::build(const SceneDescription& description) {
         if (emitter.medium != kLocateMedium) continue;
         const EmissionSample probe = emitter.sampleEmission(Vec2(0.5f, 0.5f), Vec2(0.0f, 0.0f));
         const Vec3& p = probe.ray.origin;
-        const float step = 1e-4f * (1.0f + std::max({std::abs(p.x), std::abs(p.y), std::abs(p.z)}));
+        const float step = 1e-4f * positionScale(p);
         emitter.medium = scene->mediumAt(p + probe.ray.direction * step);
     }
     return scene;
@@ -294,14 +293,14 @@ bool Scene::occluded(const Ray& ray) const {
 
 Vec3 Scene::offsetOrigin(const SurfaceHit& hit, const Vec3& direction) {
     const Vec3& p = hit.position;
-    const float scale = 1.0f + std::max({std::abs(p.x), std::abs(p.y), std::abs(p.z)});
+    const float scale = positionScale(p);
     const float side = direction.dot(hit.geometricNormal) >= 0.0f ? 1.0f : -1.0f;
     return p + hit.geometricNormal * (side * 1e-4f * scale);
 }
 
 void Scene::continuePast(Ray& ray, const SurfaceHit& hit) {
     const Vec3& p = hit.position;
-    const float scale = 1.0f + std::max({std::abs(p.x), std::abs(p.y), std::abs(p.z)});
+    const float scale = positionScale(p);
     // Grazing hits widen the window only so far.
     const float cosine = std::max(std::abs(ray.direction.dot(hit.geometricNormal)), 0.1f);
     // Float noise around the crossing: a surface coinciding with the one crossed
