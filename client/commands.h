@@ -8,5 +8,7 @@ namespace vrl {
 
 void registerRenderCommand(CLI::App& app, int& exitCode);
 void registerCompareCommand(CLI::App& app, int& exitCode);
+// submit, jobs, cancel, health
+void registerServiceCommands(CLI::App& app, int& exitCode);
 
 }  // namespace vrl

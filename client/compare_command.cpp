@@ -4,6 +4,7 @@
 #include "render/image_metrics.h"
 
 #include <cstdio>
+#include <cstring>
 #include <memory>
 
 namespace vrl {
@@ -11,6 +12,10 @@ namespace vrl {
 void registerCompareCommand(CLI::App& app, int& exitCode) {
     auto* cmd = app.add_subcommand("compare", "Compare an image with a reference: RMSE, relative RMSE, SMAPE on luminance");
     auto paths = std::make_shared<std::pair<std::string, std::string>>();
+    auto exact = std::make_shared<bool>(false);
+    cmd->add_flag("--exact", *exact,
+                  "Also require bit-identical pixels in the image and every layer (same layer names); exit 1 "
+                  "otherwise. Metadata (timings) is ignored.");
     cmd->add_option("reference", paths->first, "Reference EXR image")->required()->check(CLI::ExistingFile);
     cmd->add_option("image", paths->second, "EXR image to evaluate")->required()->check(CLI::ExistingFile);
     cmd->footer(
@@ -19,7 +24,7 @@ void registerCompareCommand(CLI::App& app, int& exitCode) {
         "  relative RMSE = sqrt(mean((I - R)^2 / (R^2 + 0.01)))\n"
         "  SMAPE         = (2/n) sum |R - I| / (R + I + 0.01)   (Vibert et al. 2019)\n"
         "Exits 1 when the sizes differ or a file cannot be read.");
-    cmd->callback([paths, &exitCode] {
+    cmd->callback([paths, exact, &exitCode] {
         try {
             const ImageSet reference = readExr(paths->first);
             const ImageSet image = readExr(paths->second);
@@ -31,6 +36,31 @@ void registerCompareCommand(CLI::App& app, int& exitCode) {
             if (m.nonFinitePixels > 0) {
                 std::printf("non-finite     %zu pixels (excluded from the sums)\n", m.nonFinitePixels);
                 exitCode = 1;
+            }
+            if (*exact) {
+                size_t differing = 0;
+                auto count = [&](const Image& a, const Image& b) {
+                    for (size_t i = 0; i < a.pixelCount(); ++i)
+                        if (std::memcmp(&a[i], &b[i], sizeof(Rgb)) != 0) ++differing;
+                };
+                count(reference.image, image.image);
+                bool sameLayers = reference.layers.size() == image.layers.size();
+                for (size_t l = 0; sameLayers && l < reference.layers.size(); ++l) {
+                    const auto& [nameA, a] = reference.layers[l];
+                    const auto& [nameB, b] = image.layers[l];
+                    sameLayers = nameA == nameB && a.width() == b.width() && a.height() == b.height();
+                    if (sameLayers) count(a, b);
+                }
+                if (!sameLayers) {
+                    std::printf("identical      no (the layers differ in names or sizes)\n");
+                    exitCode = 1;
+                } else if (differing > 0) {
+                    std::printf("identical      no (%zu pixel values differ over image and %zu layers)\n", differing,
+                                reference.layers.size());
+                    exitCode = 1;
+                } else {
+                    std::printf("identical      yes (image and %zu layers, bit for bit)\n", reference.layers.size());
+                }
             }
         } catch (const std::exception& e) {
             std::fprintf(stderr, "vrl compare: error: %s\n", e.what());

@@ -12,6 +12,8 @@ class ProgressBar {
 public:
     explicit ProgressBar(std::string label);
     void update(double fraction);  // safe from any thread; fraction in [0, 1]
+    // With a detail (e.g. "120/300 tiles, ETA 4.2 s") shown instead of the elapsed/left times.
+    void update(double fraction, const std::string& detail);
     void finish();
 
 private:

@@ -1,5 +1,9 @@
 #include "client/commands.h"
+#include "client/local_cluster.h"
 #include "client/progress_bar.h"
+#include "client/remote_render.h"
+#include "client/render_options.h"
+#include "proto/scene_bundle.h"
 
 #include "render/exr_io.h"
 #include "render/mitsuba_parser.h"
@@ -22,28 +26,7 @@ namespace vrl {
 
 namespace {
 
-struct RenderCommandOptions {
-    std::string scene;
-    std::string output;
-    std::vector<std::string> defines;
-    std::string method = "path";
-    int spp = 0;  // 0: the scene's sampleCount
-    std::string resolution;  // "WxH", empty: the scene's film
-    int threads = 0;         // 0: all cores
-    uint64_t seed = 0;
-    int maxDepth = -2;  // -2: the scene's integrator maxDepth
-    bool jitter = false;
-    bool quiet = false;
-    uint64_t vrls = 100000;
-    uint64_t lightPaths = 0;
-    int vrlSamples = 1;
-    std::string transport = "surface,single,medium-surface,multiple";
-    float error = 0.02f;
-    uint32_t maxCut = 4096;
-    uint32_t exactDistanceBelow = 32;
-    float hgEpsilon = 1.0f;
-    uint32_t partitionSize = 2048;
-};
+
 
 double secondsSince(std::chrono::steady_clock::time_point start) {
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
@@ -55,8 +38,23 @@ double peakMemoryMiB() {
     return double(usage.ru_maxrss) / 1024.0;  // ru_maxrss is in KiB on Linux
 }
 
+// `--workers N`: the same render through a coordinator and N worker processes on loopback.
+int runLocalCluster(const RenderCommandOptions& o) {
+    const int cores = tbb::info::default_concurrency();
+    const int threadsPerWorker = o.threads > 0 ? o.threads : std::max(1, cores / o.workers);
+    if (!o.quiet)
+        std::fprintf(stderr, "starting a local coordinator and %d workers (%d threads each)\n", o.workers,
+                     threadsPerWorker);
+    LocalCluster cluster(o.workers, threadsPerWorker, "warn");
+    RemoteOptions remote;
+    remote.address = cluster.address();
+    remote.token = cluster.token();
+    return runRemoteRender(o, remote);
+}
+
 int runRender(const RenderCommandOptions& o) {
     if (o.quiet) spdlog::set_level(spdlog::level::warn);
+    if (o.workers > 0) return runLocalCluster(o);
     using Clock = std::chrono::steady_clock;
     ParseOptions parseOptions;
     for (const auto& d : o.defines) {
@@ -199,61 +197,21 @@ int runRender(const RenderCommandOptions& o) {
 void registerRenderCommand(CLI::App& app, int& exitCode) {
     auto o = std::make_shared<RenderCommandOptions>();
     auto* cmd = app.add_subcommand("render", "Render a Mitsuba 0.5/0.6 XML scene to an OpenEXR image");
-    cmd->add_option("scene", o->scene, "Scene file (Mitsuba 0.5/0.6 XML subset)")->required();
-    cmd->add_option("-o,--output", o->output, "Output OpenEXR file")->required();
-    cmd->add_option("-D,--define", o->defines, "Override a scene <default>: -D name=value (repeatable)");
-    cmd->add_option("--method", o->method,
-                    "Rendering method: path (volumetric path tracer, the reference), vrl (transport parts "
-                    "(a)-(c) by path sampling, multiple scattering (d) by plain VRLs) or vrl-lightcuts (the same, "
-                    "(d) by cuts through a VRL light tree)")
-        ->check(CLI::IsMember(kRenderMethods));
-    cmd->add_option("--spp", o->spp, "Samples per pixel (default: the scene's sampler sampleCount)")
-        ->check(CLI::Range(1, kMaxSampleCount));
-    cmd->add_option("--resolution", o->resolution, "Image size WxH, overriding the scene's film (e.g. 640x480)");
-    cmd->add_option("--threads", o->threads, "Worker threads (default: all cores)")->check(CLI::Range(1, 4096));
-    cmd->add_option("--seed", o->seed, "Random seed; equal seeds give bit-identical images (default 0)");
-    cmd->add_option("--max-depth", o->maxDepth,
-                    "Path length as Mitsuba's maxDepth: 1 emitters only, 2 direct + single scattering, -1 unlimited "
-                    "(default: the scene's integrator)")
-        ->check(CLI::Validator(
-            [](std::string& value) {
-                const int depth = std::atoi(value.c_str());
-                return depth == -1 || (depth >= 1 && depth <= 100000) ? std::string()
-                                                                     : std::string("must be -1 or 1..100000");
-            },
-            "-1 or 1..100000"));
-    cmd->add_option("--vrls", o->vrls, "vrl: target number of VRLs; whole light paths are traced until reached")
-        ->check(CLI::Range(uint64_t(1), uint64_t(1) << 32));
-    cmd->add_option("--light-paths", o->lightPaths, "vrl: trace exactly this many light paths (overrides --vrls)")
-        ->check(CLI::Range(uint64_t(1), uint64_t(1) << 40));
-    cmd->add_option("--vrl-samples", o->vrlSamples, "vrl: (u, v) samples per VRL and camera segment (default 1)")
-        ->check(CLI::Range(1, 1 << 16));
-    cmd->add_option("--transport", o->transport,
-                    "vrl: parts to render, comma-separated: surface (a), single (b), medium-surface (c), multiple (d); "
-                    "each is also written as an EXR layer (default: all four)");
-    cmd->add_option("--error", o->error,
-                    "vrl-lightcuts: relative error threshold; a node is refined while its bound exceeds this times "
-                    "the current estimate (default 0.02)")
-        ->check(CLI::Range(0.0f, 1e6f));
-    cmd->add_option("--max-cut", o->maxCut, "vrl-lightcuts: most nodes in one cut, a safety valve (default 4096)")
-        ->check(CLI::Range(1u, 1u << 30));
-    cmd->add_option("--exact-distance-below", o->exactDistanceBelow,
-                    "vrl-lightcuts: nodes with at most this many VRLs take their distance to the camera ray from "
-                    "their VRLs rather than their box (default 32)")
-        ->check(CLI::Range(0u, 1u << 20));
-    cmd->add_option("--hg-epsilon", o->hgEpsilon,
-                    "vrl-lightcuts: Henyey-Greenstein media multiply the isotropic bound by (1 + this) (default 1)")
-        ->check(CLI::Range(0.0f, 1e6f));
-    cmd->add_option("--partition-size", o->partitionSize,
-                    "vrl-lightcuts: VRLs per partition before agglomerative clustering (default 2048)")
-        ->check(CLI::Range(2u, 1u << 30));
-    cmd->add_flag("--jitter", o->jitter, "Jitter camera rays inside pixels (default: through pixel centres)");
-    cmd->add_flag("-q,--quiet", o->quiet, "No progress bar and no informational logs");
+    addRenderOptions(*cmd, *o);
+    cmd->add_option("--workers", o->workers,
+                    "Render with a local coordinator and this many worker processes on loopback (default 0: "
+                    "everything in this process); the image is bit-identical")
+        ->check(CLI::Range(0, 256));
+    cmd->add_option("--tile-size", o->tileSize, "With --workers: tile side in pixels (default 32)")
+        ->check(CLI::Range(1u, 256u));
     cmd->callback([o, &exitCode] {
         try {
             exitCode = runRender(*o);
         } catch (const SceneError& e) {
             std::fprintf(stderr, "vrl render: scene error: %s\n", e.what());
+            exitCode = 2;
+        } catch (const rpc::BundleError& e) {
+            std::fprintf(stderr, "vrl render: error: %s\n", e.what());
             exitCode = 2;
         } catch (const std::invalid_argument& e) {
             std::fprintf(stderr, "vrl render: error: %s\n", e.what());

@@ -13,6 +13,8 @@ namespace vrl {
 namespace {
 
 constexpr char kMagic[8] = {'V', 'R', 'L', 'T', 'R', 'E', 'E', '\0'};
+constexpr char kSetMagic[8] = {'V', 'R', 'L', 'S', 'E', 'T', '\0', '\0'};
+constexpr size_t kSetHeaderBytes = 8 + 4 * 4;  // magic, version, count, light paths (2 x u32)
 constexpr size_t kHeaderBytes = 8 + 4 * 4;  // magic, version, vrl count, node count, root
 constexpr size_t kVrlBytes = 11 * 4;
 constexpr size_t kNodeBytes = 18 * 4;
@@ -69,6 +71,24 @@ private:
     size_t pos_ = 0;
 };
 
+void writeVrl(Writer& out, const Vrl& v) {
+    out.v3(v.origin);
+    out.v3(v.direction);
+    out.f32(v.length);
+    out.v3(v.flux);
+    out.i32(v.medium);
+}
+
+Vrl readVrl(Reader& in) {
+    Vrl v;
+    v.origin = in.v3();
+    v.direction = in.v3();
+    v.length = in.f32();
+    v.flux = in.v3();
+    v.medium = in.i32();
+    return v;
+}
+
 uint64_t blobBytes(uint64_t vrlCount, uint64_t nodeCount) {
     return kHeaderBytes + vrlCount * kVrlBytes + nodeCount * kNodeBytes + kCrcBytes;
 }
@@ -86,13 +106,7 @@ std::vector<uint8_t> serializeLightTree(const LightTree& tree) {
     out.u32(static_cast<uint32_t>(vrls.size()));
     out.u32(static_cast<uint32_t>(nodes.size()));
     out.i32(tree.root());
-    for (const Vrl& v : vrls) {
-        out.v3(v.origin);
-        out.v3(v.direction);
-        out.f32(v.length);
-        out.v3(v.flux);
-        out.i32(v.medium);
-    }
+    for (const Vrl& v : vrls) writeVrl(out, v);
     for (const LightTreeNode& n : nodes) {
         out.v3(n.box.min);
         out.v3(n.box.max);
@@ -144,13 +158,7 @@ LightTree deserializeLightTree(const uint8_t* data, size_t size) {
 
     Reader in(data + kHeaderBytes, size - kHeaderBytes - kCrcBytes);
     std::vector<Vrl> vrls(vrlCount);  // sizes verified against the blob above
-    for (Vrl& v : vrls) {
-        v.origin = in.v3();
-        v.direction = in.v3();
-        v.length = in.f32();
-        v.flux = in.v3();
-        v.medium = in.i32();
-    }
+    for (Vrl& v : vrls) v = readVrl(in);
     std::vector<LightTreeNode> nodes(nodeCount);
     for (LightTreeNode& n : nodes) {
         n.box.min = in.v3();
@@ -170,6 +178,45 @@ LightTree deserializeLightTree(const uint8_t* data, size_t size) {
         throw std::runtime_error(std::string("light tree blob holds a structurally invalid tree (checksum is valid, "
                                              "so it was written that way): ") + e.what());
     }
+}
+
+std::vector<uint8_t> serializeVrlSet(const VrlSet& set) {
+    if (set.vrls.size() > UINT32_MAX) throw std::invalid_argument("VRL set too large to serialise (over 2^32 - 1)");
+    Writer out(kSetHeaderBytes + set.vrls.size() * kVrlBytes + kCrcBytes);
+    out.bytes().insert(out.bytes().end(), std::begin(kSetMagic), std::end(kSetMagic));
+    out.u32(kLightTreeFormatVersion);
+    out.u32(static_cast<uint32_t>(set.vrls.size()));
+    out.u32(static_cast<uint32_t>(set.lightPaths));
+    out.u32(static_cast<uint32_t>(set.lightPaths >> 32));
+    for (const Vrl& v : set.vrls) writeVrl(out, v);
+    out.u32(crc32Of(out.bytes().data(), out.bytes().size()));
+    return std::move(out.bytes());
+}
+
+VrlSet deserializeVrlSet(const uint8_t* data, size_t size) {
+    if (size > 0 && data == nullptr) throw std::invalid_argument("deserializeVrlSet: null data");
+    if (size < kSetHeaderBytes + kCrcBytes || std::memcmp(data, kSetMagic, sizeof kSetMagic) != 0)
+        throw std::runtime_error("not a VRL set blob (too short, or it does not start with \"VRLSET\")");
+    Reader header(data + sizeof kSetMagic, kSetHeaderBytes - sizeof kSetMagic);
+    const uint32_t version = header.u32();
+    if (version != kLightTreeFormatVersion)
+        throw std::runtime_error("VRL set blob has format version " + std::to_string(version) +
+                                 " but this build reads version " + std::to_string(kLightTreeFormatVersion));
+    const uint32_t count = header.u32();
+    const uint64_t low = header.u32(), high = header.u32();
+    const uint64_t expected = kSetHeaderBytes + uint64_t(count) * kVrlBytes + kCrcBytes;
+    if (size != expected)
+        throw std::runtime_error("VRL set blob has the wrong size: expected " + std::to_string(expected) +
+                                 " bytes for " + std::to_string(count) + " VRLs, found " + std::to_string(size));
+    const uint32_t storedCrc = Reader(data + size - kCrcBytes, kCrcBytes).u32();
+    if (storedCrc != crc32Of(data, size - kCrcBytes))
+        throw std::runtime_error("VRL set blob is corrupt: checksum mismatch");
+    Reader in(data + kSetHeaderBytes, size - kSetHeaderBytes - kCrcBytes);
+    VrlSet set;
+    set.lightPaths = low | (high << 32);
+    set.vrls.resize(count);
+    for (Vrl& v : set.vrls) v = readVrl(in);
+    return set;
 }
 
 }  // namespace vrl

@@ -43,4 +43,12 @@ inline LightTree deserializeLightTree(const std::vector<uint8_t>& blob) {
     return deserializeLightTree(blob.data(), blob.size());
 }
 
+// The plain `vrl` method ships its VRLs without a tree, in the same style:
+//   magic "VRLSET\0\0", version u32 (kLightTreeFormatVersion), count u32,
+//   light paths u32 low + u32 high, count x VRL (44 bytes as above), crc u32.
+std::vector<uint8_t> serializeVrlSet(const VrlSet& set);
+// The inverse; throws std::runtime_error (wrong magic or version, wrong size,
+// checksum mismatch) like deserializeLightTree.
+VrlSet deserializeVrlSet(const uint8_t* data, size_t size);
+
 }  // namespace vrl

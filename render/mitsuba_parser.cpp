@@ -125,7 +125,10 @@ Rgb nonNegativeColor(const PluginParams& params, std::string_view name, const Rg
 
 class SceneParser {
 public:
-    explicit SceneParser(const ParseOptions& options) : defines_(options.defines.begin(), options.defines.end()) {}
+    explicit SceneParser(const ParseOptions& options)
+        : defines_(options.defines.begin(), options.defines.end()),
+          confineTo_(options.confineTo),
+          onFileReferenced_(options.onFileReferenced) {}
 
     SceneDescription parse(std::unique_ptr<xml::XmlFile> file, const std::filesystem::path& identity,
                            std::optional<std::filesystem::path> canonicalPath);
@@ -160,7 +163,12 @@ private:
     int referencedMedium(const Element& ref);
     int mediumChild(const Element& child, int current);  // nested <medium> or <ref> to one
 
+    // Applies ParseOptions::confineTo and ::onFileReferenced to a referenced file.
+    void checkReference(const Element& element, const std::filesystem::path& path) const;
+
     xml::Defines defines_;
+    std::optional<std::filesystem::path> confineTo_;
+    std::function<void(const std::filesystem::path&)> onFileReferenced_;
     std::vector<std::unique_ptr<xml::XmlFile>> files_;  // alive while their elements are in use
     std::vector<std::filesystem::path> includeStack_;   // canonical paths, for cycle detection
     std::map<std::string, Named> ids_;
@@ -226,6 +234,19 @@ void SceneParser::parseSceneChildren(const Element& scene) {
     }
 }
 
+void SceneParser::checkReference(const Element& element, const std::filesystem::path& path) const {
+    if (confineTo_) {
+        std::error_code error;
+        const auto root = std::filesystem::weakly_canonical(*confineTo_, error);
+        const auto target = std::filesystem::weakly_canonical(path, error);
+        const auto relative = target.lexically_relative(root);
+        if (error || relative.empty() || *relative.begin() == ".." || relative.is_absolute())
+            element.fail("'" + path.string() + "' lies outside the scene bundle; a bundled scene may only reference "
+                         "files inside it");
+    }
+    if (onFileReferenced_) onFileReferenced_(path);
+}
+
 void SceneParser::parseDefault(const Element& element) {
     element.checkAttributes({"name", "value"});
     const std::string name = element.requireAttribute("name");
@@ -240,6 +261,7 @@ void SceneParser::parseDefault(const Element& element) {
 void SceneParser::parseInclude(const Element& element) {
     element.checkAttributes({"filename"});
     const std::filesystem::path path = element.resolvePath(element.requireAttribute("filename"));
+    checkReference(element, path);
     const std::string text = xml::readTextFile(path, element.where(), "included file");
     std::error_code error;
     const std::filesystem::path canonical = std::filesystem::weakly_canonical(path, error);
@@ -484,6 +506,7 @@ void SceneParser::parseShape(const Element& element) {
         const auto filename = params.getString("filename");
         if (!filename) element.fail("missing parameter 'filename' (the .obj file)");
         shape.filename = element.resolvePath(*filename);
+        checkReference(element, shape.filename);
         std::error_code error;
         if (!std::filesystem::is_regular_file(shape.filename, error))
             params.fail("filename", "cannot find the OBJ file '" + shape.filename.string() + "'");
@@ -627,6 +650,7 @@ int SceneParser::referencedMedium(const Element& ref) {
 // ---------------------------------------------------------------- public API
 
 SceneDescription parseMitsubaScene(const std::filesystem::path& file, const ParseOptions& options) {
+    if (options.onFileReferenced) options.onFileReferenced(file);
     const std::string text = xml::readTextFile(file, {file.string(), 0, ""}, "scene file");
     auto xmlFile = std::make_unique<xml::XmlFile>(text, file.string(), file.parent_path());
     std::error_code error;

@@ -24,7 +24,9 @@
 #pragma once
 
 #include <filesystem>
+#include <functional>
 #include <map>
+#include <optional>
 #include <string>
 
 #include "render/scene_description.h"
@@ -35,6 +37,14 @@ struct ParseOptions {
     // -D name=value: defines $name, overriding the scene's <default name=...>.
     // A name with no <default> in the scene is still usable.
     std::map<std::string, std::string> defines;
+    // If set, every file the scene references (includes, meshes) must lie
+    // inside this directory once symbolic links are resolved; a reference
+    // outside it is a SceneError. Job bundles are parsed this way, so a scene
+    // cannot make the coordinator or a worker read anything else.
+    std::optional<std::filesystem::path> confineTo;
+    // If set, called with every file the parse reads or references (the scene
+    // itself, includes, meshes), in order: a client collects a job's bundle so.
+    std::function<void(const std::filesystem::path&)> onFileReferenced;
 };
 
 // Parses a Mitsuba 0.5/0.6 XML scene. Throws SceneError

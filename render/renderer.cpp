@@ -1,7 +1,6 @@
 #include "render/renderer.h"
 
 #include "render/light_tracer.h"
-#include "render/light_tree.h"
 #include "render/path_tracer.h"
 #include "render/vrl_integrator.h"
 
@@ -17,31 +16,7 @@ namespace vrl {
 
 namespace {
 
-// Runs `shadePixel(x, y, rng)` over all pixels in parallel tiles, each pixel with
-// its own stream (seed, pixel index).
-template <class ShadePixel>
-void forEachPixel(int width, int height, const RenderSettings& settings, const ProgressCallback& progress,
-                  ShadePixel&& shadePixel) {
-    const int tile = std::max(1, settings.tileSize);
-    const int tilesX = (width + tile - 1) / tile, tilesY = (height + tile - 1) / tile;
-    std::atomic<long long> pixelsDone{0};
-    const double totalPixels = double(width) * height;
-    tbb::parallel_for(tbb::blocked_range<int>(0, tilesX * tilesY, 1), [&](const tbb::blocked_range<int>& range) {
-        for (int t = range.begin(); t < range.end(); ++t) {
-            const int x0 = (t % tilesX) * tile, y0 = (t / tilesX) * tile;
-            const int x1 = std::min(width, x0 + tile), y1 = std::min(height, y0 + tile);
-            for (int y = y0; y < y1; ++y) {
-                for (int x = x0; x < x1; ++x) {
-                    Rng rng(settings.seed, uint64_t(y) * uint64_t(width) + uint64_t(x));
-                    shadePixel(x, y, rng);
-                }
-            }
-            const long long count = static_cast<long long>(x1 - x0) * (y1 - y0);
-            const long long done = pixelsDone.fetch_add(count) + count;
-            if (progress) progress("rendering", double(done) / totalPixels);
-        }
-    });
-}
+constexpr const char* kCutLayerNames[3] = {"eval", "inter", "cut"};
 
 Ray cameraRay(const PerspectiveCamera& camera, const RenderSettings& settings, int x, int y, Rng& rng) {
     const float jx = settings.jitter ? rng.next() : 0.5f;
@@ -49,106 +24,17 @@ Ray cameraRay(const PerspectiveCamera& camera, const RenderSettings& settings, i
     return camera.generateRay(float(x) + jx, float(y) + jy);
 }
 
-ImageSet renderPath(const Scene& scene, const RenderSettings& settings, const ProgressCallback& progress) {
-    const PerspectiveCamera& camera = scene.camera();
-    ImageSet result;
-    result.image = Image(camera.width(), camera.height());
-    const VolumetricPathTracer tracer(scene, PathTracerSettings{settings.maxDepth});
-    forEachPixel(camera.width(), camera.height(), settings, progress, [&](int x, int y, Rng& rng) {
-        Rgb sum(0.0f);
-        for (int s = 0; s < settings.samplesPerPixel; ++s)
-            sum += tracer.radiance(cameraRay(camera, settings, x, y, rng), scene.cameraMedium(), rng);
-        result.image.at(x, y) = sum / float(settings.samplesPerPixel);
-    });
-    return result;
+bool isVrlMethod(const RenderSettings& settings) {
+    return settings.method == "vrl" || settings.method == "vrl-lightcuts";
 }
 
-ImageSet renderVrl(const Scene& scene, const RenderSettings& settings, const ProgressCallback& progress,
-                   RenderStatistics& statistics, bool lightcuts) {
-    VrlSet vrls;
-    if (settings.transports.has(TransportPart::Multiple)) {
-        LightTracingSettings tracing;
-        tracing.lightPaths = settings.lightPaths;
-        tracing.targetVrls = settings.vrlCount;
-        tracing.maxDepth = settings.maxDepth;
-        tracing.seed = settings.seed ^ 0x5bd1e995ULL;  // a stream family apart from the camera's
-        vrls = traceVrls(scene, tracing, [&](double f) {
-            if (progress) progress("light tracing", f);
-        });
-        statistics.vrlCount = vrls.vrls.size();
-        statistics.lightPaths = vrls.lightPaths;
-        statistics.vrlBytes = vrls.memoryBytes();
-        statistics.tracingSeconds = vrls.tracingSeconds;
-    }
-    LightTree tree;
-    if (lightcuts && !vrls.vrls.empty()) {
-        if (progress) progress("building the light tree", 0.0);
-        const auto treeStart = std::chrono::steady_clock::now();
-        // The tree takes the VRLs over: shading reads them from it.
-        tree = LightTree::build(std::move(vrls.vrls), LightTreeSettings{settings.partitionSize, settings.seed});
-        vrls.vrls = {};
-        statistics.treeSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - treeStart).count();
-        statistics.treeBytes = tree.memoryBytes();
-        if (progress) progress("building the light tree", 1.0);
-    }
-    const auto start = std::chrono::steady_clock::now();
-    const PerspectiveCamera& camera = scene.camera();
-    const int width = camera.width(), height = camera.height();
-    const VrlIntegratorSettings integratorSettings{settings.transports, settings.maxDepth, settings.vrlSamples,
-                                                   settings.cut};
-    const VrlIntegrator integrator(scene, vrls, integratorSettings, lightcuts ? &tree : nullptr);
-    std::array<Image, 4> parts;
-    for (auto& part : parts) part = Image(width, height);
-    std::array<Image, 3> cutLayers;  // eval, inter, cut
-    std::atomic<uint64_t> boundExceeded{0}, boundedEstimates{0};
-    if (lightcuts)
-        for (auto& layer : cutLayers) layer = Image(width, height);
-    forEachPixel(width, height, settings, progress, [&](int x, int y, Rng& rng) {
-        std::array<Rgb, 4> sum{Rgb(0.0f), Rgb(0.0f), Rgb(0.0f), Rgb(0.0f)};
-        for (int s = 0; s < settings.samplesPerPixel; ++s) {
-            const auto sample = integrator.samplePathParts(cameraRay(camera, settings, x, y, rng), rng);
-            for (size_t p = 0; p < 3; ++p) sum[p] += sample[p];
-        }
-        for (size_t p = 0; p < 3; ++p) parts[p].at(x, y) = sum[p] / float(settings.samplesPerPixel);
-        // (d) once per pixel: its cost is per VRL, not per camera sample.
-        CutStatistics cut;
-        parts[3].at(x, y) = integrator.multipleScattering(cameraRay(camera, settings, x, y, rng), rng, &cut);
-        if (lightcuts) {
-            cutLayers[0].at(x, y) = Rgb(float(cut.evaluated));
-            cutLayers[1].at(x, y) = Rgb(float(cut.intersected));
-            cutLayers[2].at(x, y) = Rgb(float(cut.cutSize));
-            boundExceeded += cut.boundExceeded;
-            boundedEstimates += cut.boundedEstimates;
-        }
-    });
-    ImageSet result;
-    result.image = Image(width, height);
-    for (size_t p = 0; p < parts.size(); ++p) {
-        if (!settings.transports.enabled[p]) continue;
-        for (size_t i = 0; i < result.image.pixelCount(); ++i) result.image[i] += parts[p][i];
-        result.layers.emplace_back(std::string(kTransportPartNames[p]), std::move(parts[p]));
-    }
-    if (lightcuts) {
-        double sums[3] = {0, 0, 0};
-        for (size_t l = 0; l < 3; ++l)
-            for (const auto& p : cutLayers[l].pixels()) sums[l] += p.x;
-        const double n = double(width) * height;
-        statistics.meanEvaluated = sums[0] / n;
-        statistics.meanIntersected = sums[1] / n;
-        statistics.meanCutSize = sums[2] / n;
-        statistics.boundExceeded = boundExceeded.load();
-        statistics.boundedEstimates = boundedEstimates.load();
-        const char* names[] = {"eval", "inter", "cut"};
-        for (size_t l = 0; l < 3; ++l) result.layers.emplace_back(names[l], std::move(cutLayers[l]));
-    }
-    statistics.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    return result;
+double secondsSince(std::chrono::steady_clock::time_point start) {
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 
 }  // namespace
 
-ImageSet render(const Scene& scene, const RenderSettings& settings, const ProgressCallback& progress,
-                RenderStatistics* statistics) {
+void validateRenderSettings(const RenderSettings& settings) {
     if (std::find(kRenderMethods.begin(), kRenderMethods.end(), settings.method) == kRenderMethods.end()) {
         std::string valid;
         for (const auto& m : kRenderMethods) valid += (valid.empty() ? "" : ", ") + m;
@@ -156,17 +42,178 @@ ImageSet render(const Scene& scene, const RenderSettings& settings, const Progre
     }
     if (settings.samplesPerPixel < 1) throw std::invalid_argument("samples per pixel must be at least 1");
     if (settings.vrlSamples < 1) throw std::invalid_argument("samples per VRL must be at least 1");
-    RenderStatistics stats;
-    ImageSet result;
-    if (settings.method == "vrl" || settings.method == "vrl-lightcuts") {
-        if (!(settings.cut.errorThreshold >= 0.0f)) throw std::invalid_argument("the error threshold must be >= 0");
-        result = renderVrl(scene, settings, progress, stats, settings.method == "vrl-lightcuts");
-    } else {
-        const auto start = std::chrono::steady_clock::now();
-        result = renderPath(scene, settings, progress);
-        stats.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    if (!(settings.cut.errorThreshold >= 0.0f)) throw std::invalid_argument("the error threshold must be >= 0");
+}
+
+RenderLights prepareLights(const Scene& scene, const RenderSettings& settings, const ProgressCallback& progress,
+                           RenderStatistics* statistics) {
+    validateRenderSettings(settings);
+    RenderLights lights;
+    if (!isVrlMethod(settings) || !settings.transports.has(TransportPart::Multiple)) return lights;
+    RenderStatistics local;
+    RenderStatistics& stats = statistics ? *statistics : local;
+    LightTracingSettings tracing;
+    tracing.lightPaths = settings.lightPaths;
+    tracing.targetVrls = settings.vrlCount;
+    tracing.maxDepth = settings.maxDepth;
+    tracing.seed = settings.seed ^ 0x5bd1e995ULL;  // a stream family apart from the camera's
+    lights.vrls = traceVrls(scene, tracing, [&](double f) {
+        if (progress) progress("light tracing", f);
+    });
+    stats.vrlCount = lights.vrls.vrls.size();
+    stats.lightPaths = lights.vrls.lightPaths;
+    stats.vrlBytes = lights.vrls.memoryBytes();
+    stats.tracingSeconds = lights.vrls.tracingSeconds;
+    if (settings.method == "vrl-lightcuts" && !lights.vrls.vrls.empty()) {
+        if (progress) progress("building the light tree", 0.0);
+        const auto treeStart = std::chrono::steady_clock::now();
+        // The tree takes the VRLs over: shading reads them from it.
+        lights.tree = LightTree::build(std::move(lights.vrls.vrls), LightTreeSettings{settings.partitionSize, settings.seed});
+        lights.vrls.vrls = {};
+        stats.treeSeconds = secondsSince(treeStart);
+        stats.treeBytes = lights.tree.memoryBytes();
+        if (progress) progress("building the light tree", 1.0);
     }
-    stats.cameraSamples = uint64_t(scene.camera().width()) * scene.camera().height() * settings.samplesPerPixel;
+    return lights;
+}
+
+std::vector<TileRect> imageTiles(int width, int height, int tileSize) {
+    const int tile = std::max(1, tileSize);
+    std::vector<TileRect> tiles;
+    for (int y0 = 0; y0 < height; y0 += tile)
+        for (int x0 = 0; x0 < width; x0 += tile)
+            tiles.push_back({x0, y0, std::min(width, x0 + tile), std::min(height, y0 + tile)});
+    return tiles;
+}
+
+std::vector<std::string> renderLayerNames(const RenderSettings& settings) {
+    validateRenderSettings(settings);
+    std::vector<std::string> names;
+    if (!isVrlMethod(settings)) return names;
+    for (size_t p = 0; p < kTransportPartNames.size(); ++p)
+        if (settings.transports.enabled[p]) names.emplace_back(kTransportPartNames[p]);
+    if (settings.method == "vrl-lightcuts")
+        for (const char* name : kCutLayerNames) names.emplace_back(name);
+    return names;
+}
+
+TileShader::TileShader(const Scene& scene, const RenderSettings& settings, const RenderLights& lights)
+    : scene_(scene), settings_(settings), layerNames_(renderLayerNames(settings)) {
+    if (isVrlMethod(settings)) {
+        const bool lightcuts = settings.method == "vrl-lightcuts";
+        const VrlIntegratorSettings integratorSettings{settings.transports, settings.maxDepth, settings.vrlSamples,
+                                                       settings.cut};
+        integrator_ = std::make_unique<VrlIntegrator>(scene, lights.vrls, integratorSettings,
+                                                      lightcuts && lights.tree.root() >= 0 ? &lights.tree : nullptr);
+    } else {
+        tracer_ = std::make_unique<VolumetricPathTracer>(scene, PathTracerSettings{settings.maxDepth});
+    }
+}
+
+TileShader::~TileShader() = default;
+
+TileImages TileShader::renderTile(const TileRect& tile) const {
+    const PerspectiveCamera& camera = scene_.camera();
+    const int width = camera.width();
+    if (tile.x0 < 0 || tile.y0 < 0 || tile.x1 > width || tile.y1 > camera.height() || tile.x0 >= tile.x1 ||
+        tile.y0 >= tile.y1)
+        throw std::invalid_argument("tile outside the image");
+    const int w = tile.width(), h = tile.height();
+    TileImages out;
+    out.layers.assign(1 + layerNames_.size(), Image(w, h));
+    const float spp = float(settings_.samplesPerPixel);
+    for (int y = tile.y0; y < tile.y1; ++y) {
+        for (int x = tile.x0; x < tile.x1; ++x) {
+            Rng rng(settings_.seed, uint64_t(y) * uint64_t(width) + uint64_t(x));
+            const int tx = x - tile.x0, ty = y - tile.y0;
+            if (tracer_) {
+                Rgb sum(0.0f);
+                for (int s = 0; s < settings_.samplesPerPixel; ++s)
+                    sum += tracer_->radiance(cameraRay(camera, settings_, x, y, rng), scene_.cameraMedium(), rng);
+                out.layers[0].at(tx, ty) = sum / spp;
+                continue;
+            }
+            std::array<Rgb, 4> parts{Rgb(0.0f), Rgb(0.0f), Rgb(0.0f), Rgb(0.0f)};
+            for (int s = 0; s < settings_.samplesPerPixel; ++s) {
+                const auto sample = integrator_->samplePathParts(cameraRay(camera, settings_, x, y, rng), rng);
+                for (size_t p = 0; p < 3; ++p) parts[p] += sample[p];
+            }
+            for (size_t p = 0; p < 3; ++p) parts[p] /= spp;
+            // (d) once per pixel: its cost is per VRL, not per camera sample.
+            CutStatistics cut;
+            parts[3] = integrator_->multipleScattering(cameraRay(camera, settings_, x, y, rng), rng, &cut);
+            Rgb sum(0.0f);
+            size_t layer = 1;
+            for (size_t p = 0; p < parts.size(); ++p) {
+                if (!settings_.transports.enabled[p]) continue;
+                sum += parts[p];
+                out.layers[layer++].at(tx, ty) = parts[p];
+            }
+            out.layers[0].at(tx, ty) = sum;
+            if (settings_.method == "vrl-lightcuts") {
+                out.layers[layer++].at(tx, ty) = Rgb(float(cut.evaluated));
+                out.layers[layer++].at(tx, ty) = Rgb(float(cut.intersected));
+                out.layers[layer++].at(tx, ty) = Rgb(float(cut.cutSize));
+                out.boundExceeded += cut.boundExceeded;
+                out.boundedEstimates += cut.boundedEstimates;
+            }
+        }
+    }
+    return out;
+}
+
+ImageSet assembleImageSet(std::vector<Image> layers, const std::vector<std::string>& layerNames,
+                          RenderStatistics* statistics) {
+    if (layers.size() != layerNames.size() + 1) throw std::invalid_argument("assembleImageSet: layer count mismatch");
+    ImageSet result;
+    result.image = std::move(layers[0]);
+    for (size_t l = 0; l < layerNames.size(); ++l) {
+        const std::string& name = layerNames[l];
+        if (statistics) {
+            double sum = 0.0;
+            for (const auto& p : layers[l + 1].pixels()) sum += p.x;
+            const double mean = layers[l + 1].pixelCount() ? sum / double(layers[l + 1].pixelCount()) : 0.0;
+            if (name == kCutLayerNames[0]) statistics->meanEvaluated = mean;
+            if (name == kCutLayerNames[1]) statistics->meanIntersected = mean;
+            if (name == kCutLayerNames[2]) statistics->meanCutSize = mean;
+        }
+        result.layers.emplace_back(name, std::move(layers[l + 1]));
+    }
+    return result;
+}
+
+ImageSet render(const Scene& scene, const RenderSettings& settings, const ProgressCallback& progress,
+                RenderStatistics* statistics) {
+    validateRenderSettings(settings);
+    RenderStatistics stats;
+    const RenderLights lights = prepareLights(scene, settings, progress, &stats);
+    const auto start = std::chrono::steady_clock::now();
+    const TileShader shader(scene, settings, lights);
+    const int width = scene.camera().width(), height = scene.camera().height();
+    std::vector<Image> layers(1 + shader.layerNames().size(), Image(width, height));
+    const std::vector<TileRect> tiles = imageTiles(width, height, settings.tileSize);
+    std::atomic<uint64_t> boundExceeded{0}, boundedEstimates{0};
+    std::atomic<long long> pixelsDone{0};
+    const double totalPixels = double(width) * height;
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, tiles.size(), 1), [&](const tbb::blocked_range<size_t>& range) {
+        for (size_t t = range.begin(); t < range.end(); ++t) {
+            const TileRect& tile = tiles[t];
+            TileImages images = shader.renderTile(tile);
+            for (size_t l = 0; l < layers.size(); ++l)
+                for (int y = 0; y < tile.height(); ++y)
+                    std::copy_n(&images.layers[l].at(0, y), tile.width(), &layers[l].at(tile.x0, tile.y0 + y));
+            boundExceeded += images.boundExceeded;
+            boundedEstimates += images.boundedEstimates;
+            const long long count = static_cast<long long>(tile.width()) * tile.height();
+            const long long done = pixelsDone.fetch_add(count) + count;
+            if (progress) progress("rendering", double(done) / totalPixels);
+        }
+    });
+    ImageSet result = assembleImageSet(std::move(layers), shader.layerNames(), &stats);
+    stats.boundExceeded = boundExceeded.load();
+    stats.boundedEstimates = boundedEstimates.load();
+    stats.seconds = secondsSince(start);
+    stats.cameraSamples = uint64_t(width) * height * settings.samplesPerPixel;
     if (statistics) *statistics = stats;
     return result;
 }

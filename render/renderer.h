@@ -1,15 +1,19 @@
 // Renderer: turns a Scene into an image with a chosen method, in parallel tiles
 // (TBB). Every pixel's random stream is seeded from (seed, pixel index), so the
-// image is bit-identical whatever the thread count or tile order.
+// image is bit-identical whatever the thread count, tile order or process that
+// shades a tile. The phases are public so that the service can split them: the
+// coordinator runs prepareLights once, workers run TileShader on leased tiles.
 #pragma once
 
 #include "render/cut.h"
 #include "render/image.h"
+#include "render/light_tree.h"
 #include "render/scene.h"
 #include "render/transport.h"
 
 #include <cstdint>
 #include <functional>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -58,7 +62,65 @@ struct RenderStatistics {
 // "rendering"); must be thread-safe.
 using ProgressCallback = std::function<void(const char* phase, double fraction)>;
 
-// Throws std::invalid_argument for an unknown method or non-positive sample count.
+// Checks the settings; throws std::invalid_argument for an unknown method, a
+// non-positive sample count or a negative error threshold.
+void validateRenderSettings(const RenderSettings& settings);
+
+// The per-image light work of a render (the coordinator's part in the service):
+// the VRLs of the `vrl` method, or the light tree of `vrl-lightcuts` (which owns
+// its VRLs). Empty for the path tracer and when part (d) is not selected.
+struct RenderLights {
+    VrlSet vrls;
+    LightTree tree;
+};
+RenderLights prepareLights(const Scene& scene, const RenderSettings& settings, const ProgressCallback& progress = {},
+                           RenderStatistics* statistics = nullptr);
+
+// Pixels [x0, x1) x [y0, y1) of the image.
+struct TileRect {
+    int x0 = 0, y0 = 0, x1 = 0, y1 = 0;
+    int width() const { return x1 - x0; }
+    int height() const { return y1 - y0; }
+    bool operator==(const TileRect&) const = default;
+};
+// The image cut into tileSize x tileSize tiles, row by row from the top left.
+std::vector<TileRect> imageTiles(int width, int height, int tileSize);
+
+// Layers of a tile or image, in order: the image itself, then the method's layers.
+struct TileImages {
+    std::vector<Image> layers;  // each tile-sized; layers[0] is the image
+    uint64_t boundExceeded = 0, boundedEstimates = 0;
+};
+
+// Names of the layers after the image that `settings` produce ("surface", ...,
+// "eval", "inter", "cut"); throws like validateRenderSettings.
+std::vector<std::string> renderLayerNames(const RenderSettings& settings);
+
+// Shades tiles (the worker's part). Pixel (x, y) uses the stream (seed, y * width
+// + x) only, so a tile's pixels equal those of a whole-image render bit for bit.
+// renderTile is const and thread-safe; `lights` must outlive the TileShader.
+class TileShader {
+public:
+    TileShader(const Scene& scene, const RenderSettings& settings, const RenderLights& lights);
+    ~TileShader();
+    // Names of the layers after the image ("surface", ..., "eval", "inter", "cut").
+    const std::vector<std::string>& layerNames() const { return layerNames_; }
+    TileImages renderTile(const TileRect& tile) const;
+
+private:
+    const Scene& scene_;
+    RenderSettings settings_;
+    std::vector<std::string> layerNames_;
+    std::unique_ptr<class VrlIntegrator> integrator_;
+    std::unique_ptr<class VolumetricPathTracer> tracer_;
+};
+
+// Whole-image layers (one per TileShader layer, image first) into an ImageSet,
+// filling the cut statistics of `statistics` from the "eval", "inter", "cut" layers.
+ImageSet assembleImageSet(std::vector<Image> layers, const std::vector<std::string>& layerNames,
+                          RenderStatistics* statistics = nullptr);
+
+// prepareLights, then every tile in parallel (TBB), then assembleImageSet.
 // The vrl method returns the sum in .image and each selected part as a layer.
 ImageSet render(const Scene& scene, const RenderSettings& settings, const ProgressCallback& progress = {},
                 RenderStatistics* statistics = nullptr);

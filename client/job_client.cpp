@@ -1,0 +1,148 @@
+#include "client/job_client.h"
+
+#include "proto/scene_bundle.h"
+#include "render/mitsuba_parser.h"
+
+#include <fstream>
+
+namespace vrl {
+
+namespace {
+
+using namespace std::chrono_literals;
+
+void check(const grpc::Status& status, const std::string& call) {
+    if (!status.ok()) throw JobClientError(call + " failed: " + rpc::describe(status), status.error_code());
+}
+
+}  // namespace
+
+JobClient::JobClient(const std::string& address, const rpc::TlsOptions& tls, std::string token)
+    : channel_(rpc::makeChannel(address, tls)), stub_(v1::JobService::NewStub(channel_)), token_(std::move(token)) {}
+
+std::string JobClient::uploadBundle(const std::string& blob, bool* uploaded) {
+    const std::string sha256 = rpc::sha256Hex(blob);
+    {
+        grpc::ClientContext context;
+        rpc::prepareContext(context, token_, 30s);
+        context.set_wait_for_ready(true);
+        v1::BundleRef ref;
+        ref.set_sha256(sha256);
+        v1::HasBundleReply reply;
+        check(stub_->HasBundle(&context, ref, &reply), "HasBundle");
+        if (uploaded) *uploaded = !reply.present();
+        if (reply.present()) return sha256;
+    }
+    grpc::ClientContext context;
+    rpc::prepareContext(context, token_, std::chrono::minutes(30));
+    v1::UploadBundleReply reply;
+    auto writer = stub_->UploadBundle(&context, &reply);
+    uint64_t offset = 0;
+    do {
+        const size_t size = std::min<size_t>(rpc::kChunkBytes, blob.size() - offset);
+        v1::BundleChunk chunk;
+        if (offset == 0) {
+            chunk.set_sha256(sha256);
+            chunk.set_total_size(blob.size());
+        }
+        chunk.set_offset(offset);
+        chunk.set_data(blob.data() + offset, size);
+        chunk.set_crc32(rpc::crc32Of(chunk.data()));
+        if (!writer->Write(chunk)) break;  // the server ended the call; Finish says why
+        offset += size;
+    } while (offset < blob.size());
+    writer->WritesDone();
+    check(writer->Finish(), "UploadBundle");
+    return sha256;
+}
+
+std::string JobClient::submit(const v1::JobSpec& spec) {
+    grpc::ClientContext context;
+    rpc::prepareContext(context, token_, 30s);
+    v1::SubmitJobReply reply;
+    check(stub_->SubmitJob(&context, spec, &reply), "SubmitJob");
+    return reply.job_id();
+}
+
+v1::JobProgress JobClient::watch(const std::string& jobId,
+                                 const std::function<void(const v1::JobProgress&)>& onProgress) {
+    v1::JobProgress last;
+    // Long jobs: re-attach every 10 minutes so no single call needs an unbounded deadline.
+    while (true) {
+        grpc::ClientContext context;
+        rpc::prepareContext(context, token_, 10min);
+        v1::JobRef ref;
+        ref.set_job_id(jobId);
+        auto reader = stub_->WatchJob(&context, ref);
+        v1::JobProgress progress;
+        while (reader->Read(&progress)) {
+            last = progress;
+            if (onProgress) onProgress(progress);
+        }
+        const grpc::Status status = reader->Finish();
+        const auto state = last.state();
+        if (state == v1::JOB_STATE_DONE || state == v1::JOB_STATE_FAILED || state == v1::JOB_STATE_CANCELLED)
+            return last;
+        if (status.error_code() != grpc::StatusCode::DEADLINE_EXCEEDED) check(status, "WatchJob");
+    }
+}
+
+void JobClient::fetchImage(const std::string& jobId, const std::filesystem::path& path) {
+    grpc::ClientContext context;
+    rpc::prepareContext(context, token_, 30min);
+    v1::JobRef ref;
+    ref.set_job_id(jobId);
+    auto reader = stub_->FetchImage(&context, ref);
+    std::string blob, sha256;
+    uint64_t total = 0;
+    v1::DataChunk chunk;
+    while (reader->Read(&chunk)) {
+        if (chunk.offset() == 0) {
+            total = chunk.total_size();
+            sha256 = chunk.sha256();
+        }
+        if (chunk.offset() != blob.size() || rpc::crc32Of(chunk.data()) != chunk.crc32())
+            throw JobClientError("FetchImage: a corrupt chunk at offset " + std::to_string(chunk.offset()),
+                                 grpc::StatusCode::DATA_LOSS);
+        blob += chunk.data();
+    }
+    check(reader->Finish(), "FetchImage");
+    if (blob.size() != total || rpc::sha256Hex(blob) != sha256)
+        throw JobClientError("FetchImage: the image arrived incomplete or corrupt", grpc::StatusCode::DATA_LOSS);
+    const std::filesystem::path temporary = path.string() + ".partial";
+    {
+        std::ofstream out(temporary, std::ios::binary | std::ios::trunc);
+        out.write(blob.data(), std::streamsize(blob.size()));
+        if (!out) throw std::runtime_error("cannot write '" + temporary.string() + "'");
+    }
+    std::filesystem::rename(temporary, path);
+}
+
+v1::JobState JobClient::cancel(const std::string& jobId) {
+    grpc::ClientContext context;
+    rpc::prepareContext(context, token_, 30s);
+    v1::JobRef ref;
+    ref.set_job_id(jobId);
+    v1::CancelJobReply reply;
+    check(stub_->CancelJob(&context, ref, &reply), "CancelJob");
+    return reply.state();
+}
+
+std::vector<v1::JobProgress> JobClient::list() {
+    grpc::ClientContext context;
+    rpc::prepareContext(context, token_, 30s);
+    v1::ListJobsReply reply;
+    check(stub_->ListJobs(&context, v1::ListJobsRequest(), &reply), "ListJobs");
+    return {reply.jobs().begin(), reply.jobs().end()};
+}
+
+std::string collectSceneBundle(const std::filesystem::path& scene, const std::map<std::string, std::string>& defines) {
+    ParseOptions options;
+    options.defines = defines;
+    std::vector<std::filesystem::path> files;
+    options.onFileReferenced = [&](const std::filesystem::path& file) { files.push_back(file); };
+    (void)parseMitsubaScene(scene, options);  // also reports scene errors before anything is sent
+    return rpc::makeBundleBlob(scene, files);
+}
+
+}  // namespace vrl

@@ -1,0 +1,106 @@
+#include "client/render_options.h"
+
+#include "render/renderer.h"
+#include "render/scene_description.h"
+
+#include <regex>
+#include <stdexcept>
+
+namespace vrl {
+
+void addRenderOptions(CLI::App& cmd, RenderCommandOptions& o) {
+    cmd.add_option("scene", o.scene, "Scene file (Mitsuba 0.5/0.6 XML subset)")->required();
+    cmd.add_option("-o,--output", o.output, "Output OpenEXR file")->required();
+    cmd.add_option("-D,--define", o.defines, "Override a scene <default>: -D name=value (repeatable)");
+    cmd.add_option("--method", o.method,
+                    "Rendering method: path (volumetric path tracer, the reference), vrl (transport parts "
+                    "(a)-(c) by path sampling, multiple scattering (d) by plain VRLs) or vrl-lightcuts (the same, "
+                    "(d) by cuts through a VRL light tree)")
+        ->check(CLI::IsMember(kRenderMethods));
+    cmd.add_option("--spp", o.spp, "Samples per pixel (default: the scene's sampler sampleCount)")
+        ->check(CLI::Range(1, kMaxSampleCount));
+    cmd.add_option("--resolution", o.resolution, "Image size WxH, overriding the scene's film (e.g. 640x480)");
+    cmd.add_option("--threads", o.threads, "Shading threads (default: all cores; with --workers: per worker, default cores / N)")->check(CLI::Range(1, 4096));
+    cmd.add_option("--seed", o.seed, "Random seed; equal seeds give bit-identical images (default 0)");
+    cmd.add_option("--max-depth", o.maxDepth,
+                    "Path length as Mitsuba's maxDepth: 1 emitters only, 2 direct + single scattering, -1 unlimited "
+                    "(default: the scene's integrator)")
+        ->check(CLI::Validator(
+            [](std::string& value) {
+                const int depth = std::atoi(value.c_str());
+                return depth == -1 || (depth >= 1 && depth <= 100000) ? std::string()
+                                                                     : std::string("must be -1 or 1..100000");
+            },
+            "-1 or 1..100000"));
+    cmd.add_option("--vrls", o.vrls, "vrl: target number of VRLs; whole light paths are traced until reached")
+        ->check(CLI::Range(uint64_t(1), uint64_t(1) << 32));
+    cmd.add_option("--light-paths", o.lightPaths, "vrl: trace exactly this many light paths (overrides --vrls)")
+        ->check(CLI::Range(uint64_t(1), uint64_t(1) << 40));
+    cmd.add_option("--vrl-samples", o.vrlSamples, "vrl: (u, v) samples per VRL and camera segment (default 1)")
+        ->check(CLI::Range(1, 1 << 16));
+    cmd.add_option("--transport", o.transport,
+                    "vrl: parts to render, comma-separated: surface (a), single (b), medium-surface (c), multiple (d); "
+                    "each is also written as an EXR layer (default: all four)");
+    cmd.add_option("--error", o.error,
+                    "vrl-lightcuts: relative error threshold; a node is refined while its bound exceeds this times "
+                    "the current estimate (default 0.02)")
+        ->check(CLI::Range(0.0f, 1e6f));
+    cmd.add_option("--max-cut", o.maxCut, "vrl-lightcuts: most nodes in one cut, a safety valve (default 4096)")
+        ->check(CLI::Range(1u, 1u << 30));
+    cmd.add_option("--exact-distance-below", o.exactDistanceBelow,
+                    "vrl-lightcuts: nodes with at most this many VRLs take their distance to the camera ray from "
+                    "their VRLs rather than their box (default 32)")
+        ->check(CLI::Range(0u, 1u << 20));
+    cmd.add_option("--hg-epsilon", o.hgEpsilon,
+                    "vrl-lightcuts: Henyey-Greenstein media multiply the isotropic bound by (1 + this) (default 1)")
+        ->check(CLI::Range(0.0f, 1e6f));
+    cmd.add_option("--partition-size", o.partitionSize,
+                    "vrl-lightcuts: VRLs per partition before agglomerative clustering (default 2048)")
+        ->check(CLI::Range(2u, 1u << 30));
+    cmd.add_flag("--jitter", o.jitter, "Jitter camera rays inside pixels (default: through pixel centres)");
+    cmd.add_flag("-q,--quiet", o.quiet, "No progress bar and no informational logs");
+}
+
+std::map<std::string, std::string> parseDefines(const std::vector<std::string>& defines) {
+    std::map<std::string, std::string> out;
+    for (const auto& d : defines) {
+        const auto eq = d.find('=');
+        if (eq == std::string::npos || eq == 0) throw std::invalid_argument("-D expects name=value, got '" + d + "'");
+        out[d.substr(0, eq)] = d.substr(eq + 1);
+    }
+    return out;
+}
+
+std::pair<int, int> parseResolution(const std::string& text) {
+    std::smatch match;
+    const std::regex pattern("^([0-9]{1,9})x([0-9]{1,9})$");
+    if (!std::regex_match(text, match, pattern))
+        throw std::invalid_argument("--resolution expects WxH (e.g. 640x480), got '" + text + "'");
+    return {std::stoi(match[1]), std::stoi(match[2])};
+}
+
+v1::RenderParameters toRenderParameters(const RenderCommandOptions& o) {
+    v1::RenderParameters p;
+    p.set_method(o.method);
+    p.set_samples_per_pixel(o.spp);
+    p.set_seed(o.seed);
+    p.set_jitter(o.jitter);
+    p.set_max_depth(o.maxDepth);
+    if (!o.resolution.empty()) {
+        const auto [w, h] = parseResolution(o.resolution);
+        p.set_width(uint32_t(w));
+        p.set_height(uint32_t(h));
+    }
+    p.set_transport(o.transport);
+    p.set_vrl_count(o.vrls);
+    p.set_light_paths(o.lightPaths);
+    p.set_vrl_samples(o.vrlSamples);
+    p.set_error(o.error);
+    p.set_max_cut(o.maxCut);
+    p.set_exact_distance_below(o.exactDistanceBelow);
+    p.set_hg_epsilon(o.hgEpsilon);
+    p.set_partition_size(o.partitionSize);
+    return p;
+}
+
+}  // namespace vrl

@@ -1,0 +1,52 @@
+// The render flags shared by `vrl render` and `vrl submit`, and their
+// translation into the service's RenderParameters.
+#pragma once
+
+#include "vrl/v1/vrl.pb.h"
+
+#include <CLI/CLI.hpp>
+
+#include <cstdint>
+#include <map>
+#include <string>
+#include <vector>
+
+namespace vrl {
+
+struct RenderCommandOptions {
+    std::string scene;
+    std::string output;
+    std::vector<std::string> defines;
+    std::string method = "path";
+    int spp = 0;  // 0: the scene's sampleCount
+    std::string resolution;  // "WxH", empty: the scene's film
+    int threads = 0;         // 0: all cores
+    uint64_t seed = 0;
+    int maxDepth = -2;  // -2: the scene's integrator maxDepth
+    bool jitter = false;
+    bool quiet = false;
+    uint64_t vrls = 100000;
+    uint64_t lightPaths = 0;
+    int vrlSamples = 1;
+    std::string transport = "surface,single,medium-surface,multiple";
+    float error = 0.02f;
+    uint32_t maxCut = 4096;
+    uint32_t exactDistanceBelow = 32;
+    float hgEpsilon = 1.0f;
+    uint32_t partitionSize = 2048;
+    // Distributed rendering (render --workers, submit)
+    int workers = 0;       // render: 0 embedded, N: a local coordinator and N worker processes
+    uint32_t tileSize = 32;
+};
+
+// Registers the scene, output and every render flag on `cmd`.
+void addRenderOptions(CLI::App& cmd, RenderCommandOptions& o);
+
+// -D name=value list into a map; throws std::invalid_argument naming a bad entry.
+std::map<std::string, std::string> parseDefines(const std::vector<std::string>& defines);
+// "WxH" into (W, H); throws std::invalid_argument for anything else.
+std::pair<int, int> parseResolution(const std::string& text);
+// The job's parameters (width/height 0 when no --resolution).
+v1::RenderParameters toRenderParameters(const RenderCommandOptions& o);
+
+}  // namespace vrl

@@ -1,0 +1,86 @@
+#include "proto/job_scene.h"
+
+#include "render/mitsuba_parser.h"
+#include "render/scene_description.h"
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+
+namespace vrl::rpc {
+
+int jobTileSize(const v1::JobSpec& spec) { return spec.tile_size() == 0 ? 32 : int(spec.tile_size()); }
+
+void validateJobSpec(const v1::JobSpec& spec, const ServiceLimits& limits) {
+    const auto& p = spec.parameters();
+    if (std::find(kRenderMethods.begin(), kRenderMethods.end(), p.method()) == kRenderMethods.end())
+        throw JobSpecError("unknown method '" + p.method() + "' (valid: path, vrl, vrl-lightcuts)");
+    if (spec.tile_size() > limits.maxTileSize)
+        throw JobSpecError("tile size " + std::to_string(spec.tile_size()) + " exceeds the limit of " +
+                           std::to_string(limits.maxTileSize));
+    if (p.samples_per_pixel() < 0 || p.samples_per_pixel() > limits.maxSamplesPerPixel)
+        throw JobSpecError("samples per pixel must be in 0..." + std::to_string(limits.maxSamplesPerPixel) +
+                           " (0: the scene's), got " + std::to_string(p.samples_per_pixel()));
+    if (p.vrl_count() > limits.maxVrls || p.light_paths() > limits.maxVrls)
+        throw JobSpecError("the job asks for more than " + std::to_string(limits.maxVrls) +
+                           " VRLs or light paths, this coordinator's limit");
+    if (p.max_depth() < -2 || p.max_depth() == 0)
+        throw JobSpecError("max depth must be -2 (the scene's), -1 (unbounded) or positive");
+    if (p.vrl_samples() < 1 || p.vrl_samples() > 1024) throw JobSpecError("VRL samples must be in 1...1024");
+    if (!(p.error() >= 0.0f) || !std::isfinite(p.error())) throw JobSpecError("the error threshold must be >= 0");
+    if (!(p.hg_epsilon() >= 0.0f) || !std::isfinite(p.hg_epsilon())) throw JobSpecError("hg epsilon must be >= 0");
+    if (p.partition_size() < 2) throw JobSpecError("the partition size must be at least 2");
+    if ((p.width() == 0) != (p.height() == 0)) throw JobSpecError("give both width and height, or neither");
+    for (const auto& [name, value] : spec.defines())
+        if (name.empty() || name.size() > 256 || value.size() > 4096) throw JobSpecError("invalid define '" + name + "'");
+    try {
+        (void)TransportSelection::parse(p.transport());
+    } catch (const std::exception& e) {
+        throw JobSpecError(e.what());
+    }
+}
+
+JobScene loadJobScene(const std::filesystem::path& bundleDirectory, const std::filesystem::path& sceneFile,
+                      const v1::JobSpec& spec, const ServiceLimits& limits) {
+    validateJobSpec(spec, limits);
+    const auto& p = spec.parameters();
+    ParseOptions options;
+    options.defines.insert(spec.defines().begin(), spec.defines().end());
+    options.confineTo = bundleDirectory;
+    SceneDescription description = parseMitsubaScene(sceneFile, options);
+    if (p.width() > 0) {
+        description.sensor.width = int(std::min<uint32_t>(p.width(), 1u << 30));
+        description.sensor.height = int(std::min<uint32_t>(p.height(), 1u << 30));
+    }
+    const auto& sensor = description.sensor;
+    const uint64_t pixels = uint64_t(sensor.width) * uint64_t(sensor.height);
+    if (sensor.width < 1 || sensor.height < 1 || sensor.width > kMaxFilmSide || sensor.height > kMaxFilmSide ||
+        pixels > limits.maxPixels)
+        throw JobSpecError("resolution " + std::to_string(sensor.width) + "x" + std::to_string(sensor.height) +
+                           " is outside the supported range (1.." + std::to_string(kMaxFilmSide) +
+                           " per side, at most " + std::to_string(limits.maxPixels) + " pixels)");
+    JobScene job;
+    RenderSettings& s = job.settings;
+    s.method = p.method();
+    s.samplesPerPixel = p.samples_per_pixel() > 0 ? p.samples_per_pixel() : sensor.sampleCount;
+    s.seed = p.seed();
+    s.jitter = p.jitter();
+    s.maxDepth = p.max_depth() >= -1 ? p.max_depth() : description.integrator.maxDepth;
+    s.tileSize = jobTileSize(spec);
+    s.transports = TransportSelection::parse(p.transport());
+    s.vrlCount = p.vrl_count();
+    s.lightPaths = p.light_paths();
+    s.vrlSamples = p.vrl_samples();
+    s.cut.errorThreshold = p.error();
+    s.cut.maxCutSize = p.max_cut();
+    s.cut.bound.exactDistanceBelow = p.exact_distance_below();
+    s.cut.bound.anisotropyEpsilon = p.hg_epsilon();
+    s.partitionSize = p.partition_size();
+    validateRenderSettings(s);
+    job.width = sensor.width;
+    job.height = sensor.height;
+    job.scene = Scene::build(description);
+    return job;
+}
+
+}  // namespace vrl::rpc

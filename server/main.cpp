@@ -1,0 +1,3 @@
+#include "server/coordinator_main.h"
+
+int main(int argc, char** argv) { return vrl::server::coordinatorMain(argc, argv); }

@@ -1,0 +1,78 @@
+#include "worker/worker_main.h"
+
+#include "worker/worker.h"
+
+#include <CLI/CLI.hpp>
+#include <spdlog/spdlog.h>
+
+#include <csignal>
+#include <thread>
+
+namespace vrl::worker {
+
+int workerMain(int argc, char** argv) {
+    CLI::App app{"vrl-worker: shades image tiles leased from a vrl-coordinator with the scalable VRL estimator"};
+    WorkerOptions options;
+    std::string tokenFile, logLevel = "info";
+    app.add_option("--coordinator", options.coordinator, "coordinator address (host:port)")->capture_default_str();
+    app.add_option("--threads", options.threads, "shading threads (0: all cores)")->capture_default_str()
+        ->check(CLI::Range(0, 4096));
+    app.add_option("--name", options.name, "name shown in job progress (default: host:pid)");
+    app.add_option("--token-file", tokenFile,
+                   "file whose first line is the coordinator's shared token (default: VRL_TOKEN)");
+    app.add_option("--tls-ca", options.tls.caFile, "PEM CA of the coordinator's certificate: connect with TLS");
+    app.add_option("--tls-cert", options.tls.certFile, "PEM client certificate (with --tls-ca)");
+    app.add_option("--tls-key", options.tls.keyFile, "PEM private key of --tls-cert");
+    app.add_option("--cache-dir", options.cacheDir,
+                   "where downloaded bundles are kept by hash (default: a temporary folder removed at exit)");
+    app.add_option("--max-cached-jobs", options.maxCachedJobs, "jobs kept loaded at once")->capture_default_str()
+        ->check(CLI::Range(size_t(1), size_t(1024)));
+    app.add_option("--health-listen", options.healthListen,
+                   "serve the gRPC health service here (e.g. 0.0.0.0:50052) for liveness probes");
+    app.add_option("--log-level", logLevel, "trace, debug, info, warn, error")->capture_default_str()
+        ->check(CLI::IsMember({"trace", "debug", "info", "warn", "error"}));
+    try {
+        app.parse(argc, argv);
+    } catch (const CLI::ParseError& e) {
+        const int code = app.exit(e);
+        return code == 0 ? 0 : 2;
+    }
+    if (options.tls.certFile.empty() != options.tls.keyFile.empty()) {
+        std::fprintf(stderr, "vrl-worker: error: --tls-cert and --tls-key go together\n");
+        return 2;
+    }
+    spdlog::set_level(spdlog::level::from_str(logLevel));
+    sigset_t signals;
+    sigemptyset(&signals);
+    sigaddset(&signals, SIGINT);
+    sigaddset(&signals, SIGTERM);
+    pthread_sigmask(SIG_BLOCK, &signals, nullptr);
+    try {
+        options.token = rpc::loadToken(tokenFile);
+        Worker worker(options);
+        std::thread signalThread([&] {
+            int signal = 0;
+            sigwait(&signals, &signal);
+            spdlog::info("signal {}: finishing the tiles in flight", signal);
+            worker.stop();
+        });
+        int code = 0;
+        try {
+            worker.run();
+        } catch (const WorkerRefused& e) {
+            spdlog::error("{}", e.what());
+            code = 3;
+        } catch (const std::exception& e) {
+            spdlog::error("{}", e.what());
+            code = 1;
+        }
+        kill(getpid(), SIGTERM);  // wakes the signal thread if no signal came
+        signalThread.join();
+        return code;
+    } catch (const std::exception& e) {
+        spdlog::error("{}", e.what());
+        return 1;
+    }
+}
+
+}  // namespace vrl::worker
