@@ -25,7 +25,6 @@ std::string JobClient::uploadBundle(const std::string& blob, bool* uploaded) {
     {
         grpc::ClientContext context;
         rpc::prepareContext(context, token_, 30s);
-        context.set_wait_for_ready(true);
         v1::BundleRef ref;
         ref.set_sha256(sha256);
         v1::HasBundleReply reply;

@@ -88,6 +88,10 @@ v1::RenderParameters toRenderParameters(const RenderCommandOptions& o) {
     p.set_max_depth(o.maxDepth);
     if (!o.resolution.empty()) {
         const auto [w, h] = parseResolution(o.resolution);
+        if (w < 1 || h < 1 || w > kMaxFilmSide || h > kMaxFilmSide || (long long)w * h > kMaxFilmPixels)
+            throw std::invalid_argument("resolution " + o.resolution + " is outside the supported range (1.." +
+                                        std::to_string(kMaxFilmSide) + " per side, at most " +
+                                        std::to_string(kMaxFilmPixels) + " pixels)");
         p.set_width(uint32_t(w));
         p.set_height(uint32_t(h));
     }
