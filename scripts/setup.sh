@@ -9,7 +9,7 @@ packages=(
   libtbb-dev libspdlog-dev libfmt-dev libcli11-dev libpugixml-dev libtinyobjloader-dev
   libgtest-dev libgmock-dev
   libgrpc++-dev libprotobuf-dev protobuf-compiler protobuf-compiler-grpc
-  python3 python3-numpy
+  python3 python3-numpy python3-yaml openssl iproute2
 )
 
 missing=()

@@ -81,13 +81,15 @@ void expectBitIdentical(const ImageSet& expected, const ImageSet& actual) {
 // A coordinator on 127.0.0.1:<free port> with a temporary state directory.
 class Cluster {
 public:
-    explicit Cluster(server::CoordinatorOptions options = fastOptions(), fs::path stateDir = {})
+    explicit Cluster(server::CoordinatorOptions options = fastOptions(), fs::path stateDir = {},
+                     rpc::TlsOptions tls = {})
         : stateDir_(stateDir.empty() ? freshDirectory("vrl-service-test") : stateDir) {
         options.stateDir = stateDir_;
         coordinator_ = std::make_unique<server::Coordinator>(options);
         server::ServerOptions serverOptions;
         serverOptions.listen = "127.0.0.1:0";
         serverOptions.token = kToken;
+        serverOptions.tls = tls;
         server_ = std::make_unique<server::CoordinatorServer>(*coordinator_, serverOptions);
         address_ = "127.0.0.1:" + std::to_string(server_->port());
     }
@@ -116,13 +118,15 @@ public:
         o.name = name;
         return o;
     }
-    worker::Worker& startWorker(const std::string& name) {
-        auto worker = std::make_unique<worker::Worker>(workerOptions(name));
+    worker::Worker& startWorker(const std::string& name) { return startWorker(workerOptions(name)); }
+    worker::Worker& startWorker(const worker::WorkerOptions& options) {
+        auto worker = std::make_unique<worker::Worker>(options);
         worker::Worker* raw = worker.get();
         workers_.emplace_back(std::move(worker), std::thread([raw] { raw->run(); }));
         return *raw;
     }
-    JobClient client(const std::string& token = kToken) const { return JobClient(address_, {}, token); }
+    JobClient client(const std::string& token = kToken) const { return JobClient(address_, clientTls_, token); }
+    void setClientTls(const rpc::TlsOptions& tls) { clientTls_ = tls; }
     // Uploads the default scene's bundle and submits `spec`.
     std::string submit(v1::JobSpec spec) {
         JobClient c = client();
@@ -148,6 +152,7 @@ private:
     std::unique_ptr<server::Coordinator> coordinator_;
     std::unique_ptr<server::CoordinatorServer> server_;
     std::string address_;
+    rpc::TlsOptions clientTls_;
     std::vector<std::pair<std::unique_ptr<worker::Worker>, std::thread>> workers_;
 };
 
@@ -471,6 +476,61 @@ TEST(Service, UnfinishedJobsResumeAfterACoordinatorRestartAndFinishedOnesStayFet
     }
     std::error_code error;
     fs::remove_all(state, error);
+}
+
+// A CA, a server certificate for 127.0.0.1 and a worker's client certificate, made with the openssl CLI.
+void makeCertificates(const fs::path& dir) {
+    const std::string d = dir.string();
+    std::ofstream(dir / "server.ext") << "subjectAltName=IP:127.0.0.1,DNS:localhost\n";
+    std::ofstream(dir / "client.ext") << "extendedKeyUsage=clientAuth\n";
+    const std::string quiet = " > /dev/null 2>&1";
+    const std::vector<std::string> commands = {
+        "openssl req -x509 -newkey rsa:2048 -nodes -keyout " + d + "/ca.key -out " + d +
+            "/ca.pem -days 2 -subj /CN=vrl-test-ca",
+        "openssl req -newkey rsa:2048 -nodes -keyout " + d + "/server.key -out " + d + "/server.csr -subj /CN=localhost",
+        "openssl x509 -req -in " + d + "/server.csr -CA " + d + "/ca.pem -CAkey " + d + "/ca.key -CAcreateserial -out " +
+            d + "/server.pem -days 2 -extfile " + d + "/server.ext",
+        "openssl req -newkey rsa:2048 -nodes -keyout " + d + "/worker.key -out " + d + "/worker.csr -subj /CN=worker",
+        "openssl x509 -req -in " + d + "/worker.csr -CA " + d + "/ca.pem -CAkey " + d + "/ca.key -CAcreateserial -out " +
+            d + "/worker.pem -days 2 -extfile " + d + "/client.ext"};
+    for (const auto& command : commands) ASSERT_EQ(std::system((command + quiet).c_str()), 0) << command;
+}
+
+TEST(Service, TlsWithWorkerCertificatesRendersTheSameImageAndRefusesPlaintextAndCertlessWorkers) {
+    const fs::path certs = freshDirectory("vrl-tls");
+    makeCertificates(certs);
+    rpc::TlsOptions serverTls;
+    serverTls.certFile = (certs / "server.pem").string();
+    serverTls.keyFile = (certs / "server.key").string();
+    serverTls.clientCaFile = (certs / "ca.pem").string();
+    {
+        Cluster cluster(Cluster::fastOptions(), {}, serverTls);
+        rpc::TlsOptions clientTls;
+        clientTls.caFile = (certs / "ca.pem").string();
+        // A plaintext client cannot talk to a TLS coordinator.
+        EXPECT_THROW(cluster.client().list(), JobClientError);
+        cluster.setClientTls(clientTls);
+        EXPECT_NO_THROW(cluster.client().list());
+        // A worker without a client certificate is refused; one with a certificate renders.
+        worker::WorkerOptions certless = cluster.workerOptions("certless");
+        certless.tls = clientTls;
+        worker::Worker refused(certless);
+        try {
+            refused.run();
+            FAIL() << "a worker without a client certificate was accepted";
+        } catch (const worker::WorkerRefused& e) {
+            EXPECT_NE(std::string(e.what()).find("client certificate"), std::string::npos) << e.what();
+        }
+        worker::WorkerOptions good = cluster.workerOptions("certified");
+        good.tls = clientTls;
+        good.tls.certFile = (certs / "worker.pem").string();
+        good.tls.keyFile = (certs / "worker.key").string();
+        cluster.startWorker(good);
+        const v1::JobSpec spec = makeSpec("path", 1, 3, 16, 16, 8);
+        expectBitIdentical(embeddedRender(spec), cluster.waitForImage(cluster.submit(spec)));
+    }
+    std::error_code error;
+    fs::remove_all(certs, error);
 }
 
 }  // namespace
