@@ -1,5 +1,7 @@
 #include "client/local_cluster.h"
 
+#include "proto/rpc_common.h"
+
 #include <signal.h>
 #include <spawn.h>
 #include <sys/wait.h>
@@ -17,18 +19,6 @@ namespace vrl {
 
 namespace fs = std::filesystem;
 using namespace std::chrono_literals;
-
-namespace {
-
-std::string randomHex(size_t digits) {
-    std::random_device device;
-    static constexpr char kHex[] = "0123456789abcdef";
-    std::string out;
-    for (size_t i = 0; i < digits; ++i) out += kHex[device() & 15];
-    return out;
-}
-
-}  // namespace
 
 pid_t LocalCluster::spawn(const std::vector<std::string>& arguments) {
     std::vector<char*> argv;
@@ -54,8 +44,8 @@ pid_t LocalCluster::spawn(const std::vector<std::string>& arguments) {
 }
 
 LocalCluster::LocalCluster(int workers, int threadsPerWorker, const std::string& logLevel) {
-    token_ = randomHex(32);
-    stateDir_ = fs::temp_directory_path() / ("vrl-local-" + std::to_string(getpid()) + "-" + randomHex(8));
+    token_ = rpc::randomHex(32);
+    stateDir_ = fs::temp_directory_path() / ("vrl-local-" + std::to_string(getpid()) + "-" + rpc::randomHex(8));
     fs::create_directories(stateDir_);
     const fs::path portFile = stateDir_ / "port";
     processes_.emplace_back("coordinator", spawn({"vrl", "coordinator", "--listen", "127.0.0.1:0", "--state-dir",

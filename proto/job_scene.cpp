@@ -11,6 +11,26 @@ namespace vrl::rpc {
 
 int jobTileSize(const v1::JobSpec& spec) { return spec.tile_size() == 0 ? 32 : int(spec.tile_size()); }
 
+v1::RenderParameters defaultRenderParameters(const std::string& method) {
+    const RenderSettings d;
+    v1::RenderParameters p;
+    p.set_method(method);
+    p.set_samples_per_pixel(0);
+    p.set_seed(d.seed);
+    p.set_jitter(d.jitter);
+    p.set_max_depth(-2);
+    p.set_transport(d.transports.toString());
+    p.set_vrl_count(d.vrlCount);
+    p.set_light_paths(d.lightPaths);
+    p.set_vrl_samples(d.vrlSamples);
+    p.set_error(d.cut.errorThreshold);
+    p.set_max_cut(d.cut.maxCutSize);
+    p.set_exact_distance_below(d.cut.bound.exactDistanceBelow);
+    p.set_hg_epsilon(d.cut.bound.anisotropyEpsilon);
+    p.set_partition_size(d.partitionSize);
+    return p;
+}
+
 void validateJobSpec(const v1::JobSpec& spec, const ServiceLimits& limits) {
     const auto& p = spec.parameters();
     if (std::find(kRenderMethods.begin(), kRenderMethods.end(), p.method()) == kRenderMethods.end())

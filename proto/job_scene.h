@@ -34,6 +34,10 @@ void validateJobSpec(const v1::JobSpec& spec, const ServiceLimits& limits);
 JobScene loadJobScene(const std::filesystem::path& bundleDirectory, const std::filesystem::path& sceneFile,
                       const v1::JobSpec& spec, const ServiceLimits& limits);
 
+// RenderSettings' defaults as parameters: the scene's spp and depth, all four
+// transport parts, the default VRL count and cut settings.
+v1::RenderParameters defaultRenderParameters(const std::string& method);
+
 // The tile side a spec asks for (0: 32).
 int jobTileSize(const v1::JobSpec& spec);
 

@@ -5,6 +5,7 @@
 
 #include <cstdlib>
 #include <fstream>
+#include <random>
 #include <sstream>
 #include <stdexcept>
 
@@ -124,6 +125,14 @@ std::string sha256Hex(std::string_view bytes) {
 uint32_t crc32Of(std::string_view bytes) {
     return static_cast<uint32_t>(
         crc32_z(crc32_z(0L, Z_NULL, 0), reinterpret_cast<const Bytef*>(bytes.data()), bytes.size()));
+}
+
+std::string randomHex(size_t digits) {
+    std::random_device device;
+    static constexpr char kHex[] = "0123456789abcdef";
+    std::string out;
+    for (size_t i = 0; i < digits; ++i) out += kHex[device() & 15];
+    return out;
 }
 
 std::string describe(const grpc::Status& status) {

@@ -56,6 +56,9 @@ grpc::Status checkToken(const grpc::ServerContext& context, const std::string& e
 std::string sha256Hex(std::string_view bytes);
 uint32_t crc32Of(std::string_view bytes);
 
+// `digits` random lowercase hex digits from std::random_device (ids, tokens).
+std::string randomHex(size_t digits);
+
 // "DEADLINE_EXCEEDED: message" for logs and errors.
 std::string describe(const grpc::Status& status);
 

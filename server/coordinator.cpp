@@ -38,14 +38,6 @@ void writeFileAtomically(const fs::path& path, const std::string& bytes) {
     fs::rename(temporary, path);
 }
 
-std::string randomHex(size_t digits) {
-    std::random_device device;
-    static constexpr char kHex[] = "0123456789abcdef";
-    std::string out;
-    for (size_t i = 0; i < digits; ++i) out += kHex[device() & 15];
-    return out;
-}
-
 bool validHash(const std::string& sha256) {
     return sha256.size() == 64 &&
            std::all_of(sha256.begin(), sha256.end(), [](char c) { return (c >= '0' && c <= '9') || (c >= 'a' && c <= 'f'); });
@@ -186,7 +178,7 @@ std::string Coordinator::submitJob(const v1::JobSpec& spec) {
     if (!hasBundle(spec.bundle_sha256()))
         throw ServiceError(ErrorKind::NotFound, "no scene bundle " + spec.bundle_sha256() + " here; upload it first");
     auto job = std::make_unique<Job>();
-    job->id = "job-" + randomHex(12);
+    job->id = "job-" + rpc::randomHex(12);
     job->spec = spec;
     job->dir = options_.stateDir / "jobs" / job->id;
     fs::create_directories(job->dir);
@@ -459,7 +451,7 @@ v1::RegisterReply Coordinator::registerWorker(const v1::RegisterRequest& request
     if (request.threads() == 0 || request.threads() > 4096)
         throw ServiceError(ErrorKind::InvalidArgument, "a worker must announce 1..4096 threads");
     std::lock_guard lock(mutex_);
-    const std::string id = "w" + std::to_string(++nextWorker_) + "-" + randomHex(6);
+    const std::string id = "w" + std::to_string(++nextWorker_) + "-" + rpc::randomHex(6);
     WorkerRecord& worker = workers_[id];
     worker.name = request.name().empty() ? id : request.name().substr(0, 128);
     worker.threads = request.threads();

@@ -35,20 +35,12 @@ fs::path freshDirectory(const std::string& stem) {
 v1::JobSpec makeSpec(const std::string& method, int spp, uint64_t seed, int width, int height, uint32_t tile) {
     v1::JobSpec spec;
     auto& p = *spec.mutable_parameters();
-    p.set_method(method);
+    p = rpc::defaultRenderParameters(method);
     p.set_samples_per_pixel(spp);
     p.set_seed(seed);
-    p.set_max_depth(-2);
     p.set_width(uint32_t(width));
     p.set_height(uint32_t(height));
-    p.set_transport("surface,single,medium-surface,multiple");
     p.set_vrl_count(3000);
-    p.set_vrl_samples(1);
-    p.set_error(0.02f);
-    p.set_max_cut(4096);
-    p.set_exact_distance_below(32);
-    p.set_hg_epsilon(1.0f);
-    p.set_partition_size(2048);
     spec.set_tile_size(tile);
     spec.set_name("smoke-room.xml");
     return spec;
