@@ -62,14 +62,15 @@ WATCHDOG_PID=""
 cleanup() {
   local rc=$? pid ns p
   trap - EXIT INT TERM HUP USR1
-  if [ -n "$WATCHDOG_PID" ]; then kill -TERM "$WATCHDOG_PID" 2>/dev/null; wait "$WATCHDOG_PID" 2>/dev/null; fi
+  # No `wait` in here: bash can block in a wait nested inside a trap that
+  # interrupted another wait. Exited children are reaped by init afterwards.
+  [ -n "$WATCHDOG_PID" ] && kill -TERM "$WATCHDOG_PID" 2>/dev/null
   # Processes first: a namespace with live processes outlives `ip netns del`.
   for pid in ${STARTED_PIDS[@]+"${STARTED_PIDS[@]}"}; do
     if proc_alive "$pid"; then kill -TERM "$pid" 2>/dev/null; fi
   done
   for pid in ${STARTED_PIDS[@]+"${STARTED_PIDS[@]}"}; do
-    wait_gone "$pid" 5 || kill -KILL "$pid" 2>/dev/null
-    wait "$pid" 2>/dev/null
+    wait_gone "$pid" 5 || { kill -KILL "$pid" 2>/dev/null; wait_gone "$pid" 5; }
   done
   for ns in ${CREATED_NS[@]+"${CREATED_NS[@]}"}; do
     # Anything else still inside our own namespace was started by this run.
@@ -92,11 +93,14 @@ forget_pid() {
   for p in ${STARTED_PIDS[@]+"${STARTED_PIDS[@]}"}; do [ "$p" = "$1" ] || keep+=("$p"); done
   STARTED_PIDS=(${keep[@]+"${keep[@]}"})
 }
-# run_fg CMD...: run CMD in the background and wait for it, so that a signal
-# (or the watchdog) interrupts the wait at once; the EXIT trap reaps CMD.
+# run_fg LOG CMD...: run CMD in the background, its output to LOG, and wait for
+# it, so that a signal (or the watchdog) interrupts the wait at once; the EXIT
+# trap then stops CMD. (The redirection is on CMD alone, never on the call, so
+# that messages from a trap still reach this script's stdout.)
 run_fg() {
-  local p rc
-  "$@" &
+  local p rc log=$1
+  shift
+  "$@" >"$log" 2>&1 &
   p=$!
   STARTED_PIDS+=("$p")
   wait "$p"; rc=$?
@@ -200,7 +204,7 @@ echo "PASS: namespaces $NS_C, ${NS_W[0]}, ${NS_W[1]} joined by veths" \
 if command -v ping >/dev/null 2>&1; then
   for i in 0 1; do
     deadline=$((SECONDS + 10))
-    until run_fg ip netns exec "${NS_W[$i]}" ping -c 1 -W 1 "${COORD_ADDR[$i]}" >/dev/null 2>&1; do
+    until run_fg /dev/null ip netns exec "${NS_W[$i]}" ping -c 1 -W 1 "${COORD_ADDR[$i]}"; do
       [ "$SECONDS" -ge "$deadline" ] && fail "${NS_W[$i]} cannot ping ${COORD_ADDR[$i]} over ${W_DEV[$i]} within 10 s"
       sleep 0.2
     done
@@ -233,8 +237,8 @@ echo "PASS: coordinator (pid $COORD_PID) serving in $NS_C on port $PORT"
 
 for i in 0 1; do
   deadline=$((SECONDS + 30))
-  until run_fg ip netns exec "${NS_W[$i]}" timeout 10 "$VRL_BIN" health --address "${COORD_ADDR[$i]}:$PORT" \
-          >"$TMP/health$((i + 1)).log" 2>&1; do
+  until run_fg "$TMP/health$((i + 1)).log" \
+          ip netns exec "${NS_W[$i]}" timeout 10 "$VRL_BIN" health --address "${COORD_ADDR[$i]}:$PORT"; do
     [ "$SECONDS" -ge "$deadline" ] &&
       fail "vrl health from ${NS_W[$i]} to ${COORD_ADDR[$i]}:$PORT did not report SERVING within 30 s"
     sleep 0.5
@@ -277,8 +281,8 @@ done
 
 # ---- the job -----------------------------------------------------------------
 t0=$SECONDS
-run_fg ip netns exec "$NS_C" timeout 120 "$VRL_BIN" submit --coordinator "127.0.0.1:$PORT" "$SCENE" \
-  -o "$TMP/distributed.exr" "${RENDER_FLAGS[@]}" -q >"$TMP/submit.log" 2>&1
+run_fg "$TMP/submit.log" ip netns exec "$NS_C" timeout 120 "$VRL_BIN" submit --coordinator "127.0.0.1:$PORT" \
+  "$SCENE" -o "$TMP/distributed.exr" "${RENDER_FLAGS[@]}" -q
 rc=$?
 if [ "$rc" -eq 124 ]; then fail "vrl submit did not finish within 120 s"
 elif [ "$rc" -ne 0 ]; then fail "vrl submit failed (exit status $rc)"; fi
@@ -292,11 +296,11 @@ for i in 0 1; do
   RX1[$i]=$(veth_stat "${NS_W[$i]}" "${W_DEV[$i]}" rx_bytes)
 done
 
-run_fg timeout 120 "$VRL_BIN" render "$SCENE" -o "$TMP/embedded.exr" "${RENDER_FLAGS[@]}" -q >"$TMP/embedded.log" 2>&1
+run_fg "$TMP/embedded.log" timeout 120 "$VRL_BIN" render "$SCENE" -o "$TMP/embedded.exr" "${RENDER_FLAGS[@]}" -q
 rc=$?
 [ "$rc" -eq 0 ] || fail "embedded vrl render failed or timed out (exit status $rc)"
 
-if ! run_fg timeout 60 "$VRL_BIN" compare --exact "$TMP/distributed.exr" "$TMP/embedded.exr" >"$TMP/compare.log" 2>&1; then
+if ! run_fg "$TMP/compare.log" timeout 60 "$VRL_BIN" compare --exact "$TMP/distributed.exr" "$TMP/embedded.exr"; then
   fail "distributed image differs from the embedded render (vrl compare --exact)"
 fi
 echo "PASS: distributed image is bit-identical to the embedded render: $(grep -m1 identical "$TMP/compare.log")"
