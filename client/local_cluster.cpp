@@ -31,14 +31,14 @@ pid_t LocalCluster::spawn(const std::vector<std::string>& arguments) {
     std::vector<char*> envp;
     for (auto& e : environment) envp.push_back(e.data());
     envp.push_back(nullptr);
-    // The children take SIGINT/SIGTERM from us, not from the terminal's Ctrl-C.
-    posix_spawnattr_t attributes;
-    posix_spawnattr_init(&attributes);
-    posix_spawnattr_setflags(&attributes, POSIX_SPAWN_SETPGROUP);
-    posix_spawnattr_setpgroup(&attributes, 0);
+    // Same process group: Ctrl-C reaches the children too (they stop gracefully);
+    // VRL_EXIT_WITH_PARENT makes them stop if this process dies without cleaning up.
+    environment.push_back("VRL_EXIT_WITH_PARENT=1");
+    envp.clear();
+    for (auto& e : environment) envp.push_back(e.data());
+    envp.push_back(nullptr);
     pid_t pid = 0;
-    const int error = posix_spawn(&pid, "/proc/self/exe", nullptr, &attributes, argv.data(), envp.data());
-    posix_spawnattr_destroy(&attributes);
+    const int error = posix_spawn(&pid, "/proc/self/exe", nullptr, nullptr, argv.data(), envp.data());
     if (error != 0) throw std::runtime_error("cannot start '" + arguments[0] + " " + arguments[1] + "'");
     return pid;
 }

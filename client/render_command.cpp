@@ -1,4 +1,5 @@
 #include "client/commands.h"
+#include "client/job_client.h"
 #include "client/local_cluster.h"
 #include "client/progress_bar.h"
 #include "client/remote_render.h"
@@ -16,7 +17,9 @@
 #include <tbb/info.h>
 #include <tbb/task_arena.h>
 
+#include <atomic>
 #include <chrono>
+#include <thread>
 #include <cstdio>
 #include <memory>
 #include <mutex>
@@ -49,7 +52,34 @@ int runLocalCluster(const RenderCommandOptions& o) {
     RemoteOptions remote;
     remote.address = cluster.address();
     remote.token = cluster.token();
-    return runRemoteRender(o, remote);
+    // If every worker dies, cancel the job rather than wait for ever (a dead coordinator ends the watch by itself).
+    std::atomic<bool> finished{false};
+    std::thread watchdog([&] {
+        while (!finished) {
+            std::this_thread::sleep_for(std::chrono::milliseconds(100));
+            size_t workersExited = 0;
+            for (const auto& name : cluster.exitedProcesses()) workersExited += name.rfind("worker", 0) == 0;
+            if (workersExited < size_t(o.workers) || finished) continue;
+            std::fprintf(stderr, "vrl render: error: every local worker exited (see their messages above)\n");
+            try {
+                JobClient client(remote.address, {}, remote.token);
+                for (const auto& job : client.list()) client.cancel(job.job_id());
+            } catch (const std::exception&) {
+            }
+            return;
+        }
+    });
+    int code = 1;
+    try {
+        code = runRemoteRender(o, remote);
+    } catch (...) {
+        finished = true;
+        watchdog.join();
+        throw;
+    }
+    finished = true;
+    watchdog.join();
+    return code;
 }
 
 int runRender(const RenderCommandOptions& o) {

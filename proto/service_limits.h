@@ -13,6 +13,7 @@ struct ServiceLimits {
     uint64_t maxVrls = 50'000'000;         // VRLs (or light paths) a job may ask for (~2.2 GB of VRLs)
     uint64_t maxPixels = 64ULL << 20;      // width x height (also each side <= 16384)
     uint32_t maxTileSize = 256;            // tile side
+    uint64_t maxTiles = 1 << 20;           // tiles per image (a bound on per-tile bookkeeping)
     int maxSamplesPerPixel = 1 << 20;
 };
 

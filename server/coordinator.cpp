@@ -29,7 +29,7 @@ bool isTerminal(v1::JobState state) {
 }
 
 void writeFileAtomically(const fs::path& path, const std::string& bytes) {
-    const fs::path temporary = path.string() + ".tmp";
+    const fs::path temporary = path.string() + "." + rpc::randomHex(8) + ".tmp";  // concurrent writers never share one
     {
         std::ofstream out(temporary, std::ios::binary | std::ios::trunc);
         out.write(bytes.data(), std::streamsize(bytes.size()));
@@ -61,7 +61,8 @@ struct Coordinator::Job {
     std::map<std::pair<int, int>, uint32_t> tileAt;  // (x0, y0) -> tile
     std::vector<std::string> layerNames;
     v1::JobAssets assets;
-    std::deque<uint32_t> pending;
+    std::deque<uint32_t> pending;  // may hold tiles done since they were queued: skipped when popped
+    std::vector<uint8_t> queued;   // tile is in `pending`
     std::vector<uint8_t> done;
     std::vector<int> rejections;
     uint32_t doneCount = 0;
@@ -181,6 +182,7 @@ std::string Coordinator::submitJob(const v1::JobSpec& spec) {
     job->id = "job-" + rpc::randomHex(12);
     job->spec = spec;
     job->dir = options_.stateDir / "jobs" / job->id;
+    if (draining()) throw ServiceError(ErrorKind::FailedPrecondition, "the coordinator is shutting down");
     fs::create_directories(job->dir);
     std::string bytes;
     spec.SerializeToString(&bytes);
@@ -188,7 +190,6 @@ std::string Coordinator::submitJob(const v1::JobSpec& spec) {
     const std::string id = job->id;
     {
         std::lock_guard lock(mutex_);
-        if (draining_) throw ServiceError(ErrorKind::FailedPrecondition, "the coordinator is shutting down");
         job->sequence = nextSequence_++;
         jobs_.emplace(id, std::move(job));
     }
@@ -378,20 +379,32 @@ void Coordinator::prepare(Job& job) {
         const std::string lightsSha = lightsBlob ? rpc::sha256Hex(*lightsBlob) : "";
         if (lightsBlob) phases.emplace_back("serialise lights", secondsSince(t0));
         const auto layerNames = renderLayerNames(scene.settings);
+        const uint64_t tileSide = uint64_t(scene.settings.tileSize);
+        const uint64_t tileCount = ((uint64_t(scene.width) + tileSide - 1) / tileSide) *
+                                   ((uint64_t(scene.height) + tileSide - 1) / tileSide);
+        if (tileCount > options_.limits.maxTiles)
+            throw rpc::JobSpecError("the image would have " + std::to_string(tileCount) + " tiles, over the limit of " +
+                                    std::to_string(options_.limits.maxTiles) + "; use a larger tile size");
         const auto tiles = imageTiles(scene.width, scene.height, scene.settings.tileSize);
 
         // Accepted tiles from before a restart.
         std::vector<v1::TileResult> replay;
         if (fs::exists(job.dir / "tiles.log")) {
-            std::ifstream in(job.dir / "tiles.log", std::ios::binary);
-            while (true) {
-                uint32_t size = 0;
-                if (!in.read(reinterpret_cast<char*>(&size), 4) || size > uint32_t(rpc::kMaxMessageBytes)) break;
-                std::string record(size, '\0');
-                if (!in.read(record.data(), size)) break;  // a record cut short by a crash
-                v1::TileResult result;
-                if (result.ParseFromString(record)) replay.push_back(std::move(result));
+            uint64_t good = 0;  // bytes of whole records
+            {
+                std::ifstream in(job.dir / "tiles.log", std::ios::binary);
+                while (true) {
+                    uint32_t size = 0;
+                    if (!in.read(reinterpret_cast<char*>(&size), 4) || size > uint32_t(rpc::kMaxMessageBytes)) break;
+                    std::string record(size, '\0');
+                    if (!in.read(record.data(), size)) break;  // a record cut short by a crash
+                    v1::TileResult result;
+                    if (!result.ParseFromString(record)) break;
+                    replay.push_back(std::move(result));
+                    good += 4 + uint64_t(size);
+                }
             }
+            fs::resize_file(job.dir / "tiles.log", good);  // new records go right after the last whole one
         }
 
         std::lock_guard lock(mutex_);
@@ -402,6 +415,7 @@ void Coordinator::prepare(Job& job) {
         for (uint32_t t = 0; t < tiles.size(); ++t) job.tileAt[{tiles[t].x0, tiles[t].y0}] = t;
         job.layerNames = layerNames;
         job.done.assign(tiles.size(), 0);
+        job.queued.assign(tiles.size(), 0);
         job.rejections.assign(tiles.size(), 0);
         job.doneCount = 0;
         job.layers.assign(1 + layerNames.size(), Image(scene.width, scene.height));
@@ -425,7 +439,10 @@ void Coordinator::prepare(Job& job) {
         for (const auto& result : replay) (void)applyTile(job, result, true);
         job.doneAtStart = job.doneCount;
         for (uint32_t t = 0; t < tiles.size(); ++t)
-            if (!job.done[t]) job.pending.push_back(t);
+            if (!job.done[t]) {
+                job.pending.push_back(t);
+                job.queued[t] = 1;
+            }
         job.checkpoint.open(job.dir / "tiles.log", std::ios::binary | std::ios::app);
         job.renderStart = Clock::now();
         spdlog::info("{}: prepared in {:.3f} s: {}x{}, {} tiles ({} restored), {} VRLs, lights blob {} bytes", job.id,
@@ -483,7 +500,10 @@ v1::LeaseReply Coordinator::leaseTiles(const v1::LeaseRequest& request) {
     worker->second.lastHeartbeat = Clock::now();
     v1::LeaseReply reply;
     reply.set_draining(draining_);
-    if (draining_) return reply;
+    if (draining_) {
+        reply.set_retry_after_ms(1000);
+        return reply;
+    }
     std::vector<Job*> ready;
     for (const auto& [id, job] : jobs_)
         if (job->state == v1::JOB_STATE_RENDERING && !job->pending.empty()) ready.push_back(job.get());
@@ -497,6 +517,8 @@ v1::LeaseReply Coordinator::leaseTiles(const v1::LeaseRequest& request) {
         while (uint32_t(reply.leases_size()) < wanted && !job->pending.empty()) {
             const uint32_t tile = job->pending.front();
             job->pending.pop_front();
+            job->queued[tile] = 0;
+            if (job->done[tile]) continue;  // accepted since it was queued
             const std::string leaseId = job->id + ":" + std::to_string(tile) + ":" + std::to_string(++nextLease_);
             leases_[leaseId] = Lease{job->id, tile, request.worker_id(), Clock::now() + options_.leaseTimeout};
             auto* lease = reply.add_leases();
@@ -552,7 +574,7 @@ std::string Coordinator::applyTile(Job& job, const v1::TileResult& result, bool 
     for (int l = 0; l < result.layers_size(); ++l) {
         const char* data = result.layers(l).rgb().data();
         for (int y = 0; y < rect.height(); ++y)
-            std::memcpy(&job.layers[size_t(l)].at(rect.x0, rect.y0 + y), data + size_t(y) * rect.width() * 3 * sizeof(float),
+            std::memcpy(static_cast<void*>(&job.layers[size_t(l)].at(rect.x0, rect.y0 + y)), data + size_t(y) * rect.width() * 3 * sizeof(float),
                         size_t(rect.width()) * 3 * sizeof(float));
     }
     job.done[tile] = 1;
@@ -585,7 +607,17 @@ v1::SubmitTileReply Coordinator::submitTile(const v1::TileResult& result) {
     const auto jobIt = jobs_.find(result.job_id());
     if (jobIt == jobs_.end()) throw ServiceError(ErrorKind::NotFound, "no job '" + result.job_id() + "'");
     Job& job = *jobIt->second;
-    const auto leaseIt = leases_.find(result.lease_id());
+    if (!workers_.count(result.worker_id()))
+        throw ServiceError(ErrorKind::FailedPrecondition, "unknown worker '" + result.worker_id() + "'; register again");
+    // The lease counts only if it is this worker's lease on this job's tile.
+    auto leaseIt = leases_.find(result.lease_id());
+    if (leaseIt != leases_.end()) {
+        const Lease& lease = leaseIt->second;
+        const auto at = job.tileAt.find({int(result.tile().x0()), int(result.tile().y0())});
+        if (lease.jobId != job.id || lease.workerId != result.worker_id() || at == job.tileAt.end() ||
+            at->second != lease.tile)
+            leaseIt = leases_.end();
+    }
     if (job.state != v1::JOB_STATE_RENDERING) {
         if (leaseIt != leases_.end()) leases_.erase(leaseIt);
         reply.set_reason("job is " + v1::JobState_Name(job.state));
@@ -595,12 +627,7 @@ v1::SubmitTileReply Coordinator::submitTile(const v1::TileResult& result) {
     if (refused.empty()) {
         reply.set_accepted(true);
         ++statistics_.tilesAccepted;
-        const auto& t = result.tile();
-        const uint32_t tile = job.tileAt.at({int(t.x0()), int(t.y0())});
-        // Any other lease on this tile (a requeued copy) is now moot.
-        for (auto it = leases_.begin(); it != leases_.end();)
-            it = it->second.jobId == job.id && it->second.tile == tile ? leases_.erase(it) : std::next(it);
-        job.pending.erase(std::remove(job.pending.begin(), job.pending.end(), tile), job.pending.end());
+        if (leaseIt != leases_.end()) leases_.erase(leaseIt);  // other leases on the tile expire harmlessly
         touch(job);
         if (job.doneCount == job.tiles.size()) finishJob(job);
     } else {
@@ -610,11 +637,8 @@ v1::SubmitTileReply Coordinator::submitTile(const v1::TileResult& result) {
             spdlog::warn("{}: tile result from {} refused: {}", job.id, result.worker_id(), refused);
             if (leaseIt != leases_.end()) {
                 const uint32_t tile = leaseIt->second.tile;
-                requeue(result.lease_id());
-                if (++job.rejections[tile] >= options_.maxTileRejections)
-                    endJob(job, v1::JOB_STATE_FAILED,
-                           "tile " + std::to_string(tile) + " was refused " + std::to_string(job.rejections[tile]) +
-                               " times (last: " + refused + ")");
+                requeue(result.lease_id(), false);
+                countFailure(job, tile, refused);
             }
         } else if (leaseIt != leases_.end()) {
             leases_.erase(leaseIt);
@@ -624,22 +648,38 @@ v1::SubmitTileReply Coordinator::submitTile(const v1::TileResult& result) {
     return reply;
 }
 
-void Coordinator::requeue(const std::string& leaseId) {
+void Coordinator::countFailure(Job& job, uint32_t tile, const std::string& reason) {
+    if (job.state != v1::JOB_STATE_RENDERING || ++job.rejections[tile] < options_.maxTileRejections) return;
+    endJob(job, v1::JOB_STATE_FAILED,
+           "tile " + std::to_string(tile) + " failed " + std::to_string(job.rejections[tile]) + " times (last: " +
+               reason + ")");
+}
+
+void Coordinator::requeue(const std::string& leaseId, bool front) {
     const auto it = leases_.find(leaseId);
     if (it == leases_.end()) return;
     const Lease lease = it->second;
     leases_.erase(it);
     const auto job = jobs_.find(lease.jobId);
     if (job == jobs_.end() || job->second->state != v1::JOB_STATE_RENDERING || job->second->done[lease.tile]) return;
-    auto& pending = job->second->pending;
-    if (std::find(pending.begin(), pending.end(), lease.tile) == pending.end()) pending.push_front(lease.tile);
+    Job& owner = *job->second;
+    if (owner.queued[lease.tile]) return;
+    owner.queued[lease.tile] = 1;
+    if (front) owner.pending.push_front(lease.tile);
+    else owner.pending.push_back(lease.tile);
 }
 
 void Coordinator::releaseLeases(const v1::ReleaseRequest& request) {
     std::lock_guard lock(mutex_);
     for (const auto& id : request.lease_ids()) {
         const auto it = leases_.find(id);
-        if (it != leases_.end() && it->second.workerId == request.worker_id()) requeue(id);
+        if (it == leases_.end() || it->second.workerId != request.worker_id()) continue;
+        const std::string jobId = it->second.jobId;
+        const uint32_t tile = it->second.tile;
+        requeue(id, request.failure().empty());
+        if (!request.failure().empty())
+            if (const auto job = jobs_.find(jobId); job != jobs_.end())
+                countFailure(*job->second, tile, "a worker could not shade it: " + request.failure());
     }
 }
 

@@ -5,9 +5,11 @@
 // writes the finished EXR under the state directory.
 //
 // Leases: a lease not completed by its deadline, or held by a worker whose
-// heartbeats stopped, goes back to the queue; a late or duplicate result is
-// dropped, never merged twice; results are checked (tile, layers, sizes, finite
-// values) before they are accepted.
+// heartbeats stopped, goes back to the queue; a tile's first valid result is
+// merged (even a late one, if the tile is still missing: the pixels are the
+// same), any later one is dropped, never merged twice; results are checked
+// (registered worker, tile, layers, sizes, finite values) before they are
+// accepted. A tile refused or given up maxTileRejections times fails its job.
 //
 // What survives a restart (same --state-dir): uploaded bundles, every job's
 // spec, finished jobs (their EXR and record), and the accepted tiles of
@@ -118,7 +120,9 @@ private:
     std::string applyTile(Job& job, const v1::TileResult& result, bool replay);
     void finishJob(Job& job);                     // lock held: all tiles done
     void endJob(Job& job, v1::JobState state, const std::string& message);  // lock held
-    void requeue(const std::string& leaseId);     // lock held
+    // Lock held. front: an expired lease (soon again); back: a refused tile (others first).
+    void requeue(const std::string& leaseId, bool front = true);
+    void countFailure(Job& job, uint32_t tile, const std::string& reason);  // lock held
     void pruneAssets();                           // lock held
     void touch(Job& job);                         // lock held: version++ and notify
 

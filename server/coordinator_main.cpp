@@ -7,6 +7,9 @@
 #include <tbb/global_control.h>
 
 #include <csignal>
+#include <cstdlib>
+#include <sys/prctl.h>
+#include <unistd.h>
 #include <fstream>
 #include <optional>
 
@@ -70,6 +73,11 @@ int coordinatorMain(int argc, char** argv) {
     sigaddset(&signals, SIGINT);
     sigaddset(&signals, SIGTERM);
     pthread_sigmask(SIG_BLOCK, &signals, nullptr);
+    // Started by `vrl render --workers`: stop (gracefully, via SIGTERM) when that process dies.
+    if (std::getenv("VRL_EXIT_WITH_PARENT")) {
+        prctl(PR_SET_PDEATHSIG, SIGTERM);
+        if (getppid() == 1) return 1;  // the parent is already gone
+    }
 
     std::optional<tbb::global_control> threadLimit;
     if (threads > 0) threadLimit.emplace(tbb::global_control::max_allowed_parallelism, size_t(threads));

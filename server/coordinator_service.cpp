@@ -89,7 +89,6 @@ public:
                         return {grpc::StatusCode::RESOURCE_EXHAUSTED,
                                 "scene bundle of " + std::to_string(total) + " bytes exceeds the limit of " +
                                     std::to_string(limit) + " bytes"};
-                    blob.reserve(total);
                     first = false;
                 }
                 if (chunk.offset() != blob.size())
@@ -175,9 +174,7 @@ public:
 
     grpc::Status Register(grpc::ServerContext* context, const v1::RegisterRequest* request,
                           v1::RegisterReply* reply) override {
-        return guarded(context, token_, [&]() -> grpc::Status {
-            if (requireCertificate_ && !context->auth_context()->IsPeerAuthenticated())
-                return {grpc::StatusCode::UNAUTHENTICATED, "workers must present a client certificate"};
+        return guardedWorker(context, [&]() -> grpc::Status {
             *reply = c_.registerWorker(*request);
             return grpc::Status::OK;
         });
@@ -185,7 +182,7 @@ public:
 
     grpc::Status Heartbeat(grpc::ServerContext* context, const v1::HeartbeatRequest* request,
                            v1::HeartbeatReply* reply) override {
-        return guarded(context, token_, [&] {
+        return guardedWorker(context, [&] {
             *reply = c_.heartbeat(request->worker_id());
             return grpc::Status::OK;
         });
@@ -193,7 +190,7 @@ public:
 
     grpc::Status LeaseTiles(grpc::ServerContext* context, const v1::LeaseRequest* request,
                             v1::LeaseReply* reply) override {
-        return guarded(context, token_, [&] {
+        return guardedWorker(context, [&] {
             *reply = c_.leaseTiles(*request);
             return grpc::Status::OK;
         });
@@ -201,7 +198,7 @@ public:
 
     grpc::Status FetchAsset(grpc::ServerContext* context, const v1::FetchAssetRequest* request,
                             grpc::ServerWriter<v1::DataChunk>* writer) override {
-        return guarded(context, token_, [&] {
+        return guardedWorker(context, [&] {
             const auto blob = c_.asset(request->sha256());
             return streamBlob(context, *blob, request->sha256(), request->offset(), writer);
         });
@@ -209,7 +206,7 @@ public:
 
     grpc::Status SubmitTile(grpc::ServerContext* context, const v1::TileResult* request,
                             v1::SubmitTileReply* reply) override {
-        return guarded(context, token_, [&] {
+        return guardedWorker(context, [&] {
             *reply = c_.submitTile(*request);
             return grpc::Status::OK;
         });
@@ -217,13 +214,21 @@ public:
 
     grpc::Status ReleaseLeases(grpc::ServerContext* context, const v1::ReleaseRequest* request,
                                v1::ReleaseReply*) override {
-        return guarded(context, token_, [&] {
+        return guardedWorker(context, [&] {
             c_.releaseLeases(*request);
             return grpc::Status::OK;
         });
     }
 
 private:
+    // The token, and with --tls-client-ca a verified client certificate, on every worker call.
+    template <class Body>
+    grpc::Status guardedWorker(grpc::ServerContext* context, Body&& body) {
+        if (requireCertificate_ && !context->auth_context()->IsPeerAuthenticated())
+            return {grpc::StatusCode::UNAUTHENTICATED, "workers must present a client certificate"};
+        return guarded(context, token_, std::forward<Body>(body));
+    }
+
     Coordinator& c_;
     std::string token_;
     bool requireCertificate_;

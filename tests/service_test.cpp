@@ -442,6 +442,73 @@ TEST(Service, TileResultsAreTakenOnceAndCheckedBeforeMerging) {
     fs::remove_all(state, error);
 }
 
+TEST(Service, AJobNoWorkerCanShadeFailsWithTheWorkersReasonAndForeignLeasesAreIgnored) {
+    const fs::path state = freshDirectory("vrl-coordinator-failures");
+    {
+        server::CoordinatorOptions options = Cluster::fastOptions();
+        options.stateDir = state;
+        options.leaseTimeout = 60s;
+        options.heartbeatTimeout = 60s;
+        server::Coordinator coordinator(options);
+        const std::string blob = collectSceneBundle(kScene, {});
+        const std::string sha = rpc::sha256Hex(blob);
+        coordinator.storeBundle(sha, blob);
+        v1::JobSpec big = makeSpec("path", 1, 0, 64, 64, 8);  // 64 tiles
+        big.set_bundle_sha256(sha);
+        v1::JobSpec small = makeSpec("path", 1, 0, 8, 8, 8);  // 1 tile, higher priority: leased first
+        small.set_bundle_sha256(sha);
+        small.set_priority(1);
+        const std::string bigId = coordinator.submitJob(big);
+        const std::string smallId = coordinator.submitJob(small);
+        v1::RegisterRequest hello;
+        hello.set_protocol_version(rpc::kProtocolVersion);
+        hello.set_program_version(VRL_VERSION);
+        hello.set_threads(1);
+        const std::string workerId = coordinator.registerWorker(hello).worker_id();
+        v1::LeaseRequest ask;
+        ask.set_worker_id(workerId);
+        ask.set_max_tiles(1);
+        waitUntil([&] { return coordinator.jobProgress(bigId).state() == v1::JOB_STATE_RENDERING &&
+                               coordinator.jobProgress(smallId).state() == v1::JOB_STATE_RENDERING; });
+        // A result for the small job carrying a lease of the big one is refused without touching the big job.
+        ask.set_max_tiles(2);
+        const v1::LeaseReply two = coordinator.leaseTiles(ask);
+        ASSERT_EQ(two.leases_size(), 2);
+        ASSERT_EQ(two.leases(0).job_id(), smallId);
+        ASSERT_EQ(two.leases(1).job_id(), bigId);
+        v1::TileResult forged;
+        forged.set_worker_id(workerId);
+        forged.set_job_id(smallId);
+        forged.set_lease_id(two.leases(1).lease_id());
+        *forged.mutable_tile() = two.leases(1).tile();
+        EXPECT_FALSE(coordinator.submitTile(forged).accepted());
+        EXPECT_EQ(coordinator.activeLeases(), 2u);  // the big job's lease is untouched
+        // A worker that cannot shade the small job gives its lease back with a reason, three times.
+        std::string lastLease = two.leases(0).lease_id();
+        for (int attempt = 0; attempt < options.maxTileRejections; ++attempt) {
+            v1::ReleaseRequest release;
+            release.set_worker_id(workerId);
+            release.set_failure("cannot load the job: test");
+            release.add_lease_ids(lastLease);
+            coordinator.releaseLeases(release);
+            if (attempt + 1 < options.maxTileRejections) {
+                ask.set_max_tiles(1);
+                const v1::LeaseReply again = coordinator.leaseTiles(ask);
+                ASSERT_EQ(again.leases_size(), 1);
+                ASSERT_EQ(again.leases(0).job_id(), smallId);
+                lastLease = again.leases(0).lease_id();
+            }
+        }
+        const v1::JobProgress failed = coordinator.jobProgress(smallId);
+        EXPECT_EQ(failed.state(), v1::JOB_STATE_FAILED);
+        EXPECT_NE(failed.message().find("could not shade it: cannot load the job: test"), std::string::npos)
+            << failed.message();
+        EXPECT_EQ(coordinator.jobProgress(bigId).state(), v1::JOB_STATE_RENDERING);
+    }
+    std::error_code error;
+    fs::remove_all(state, error);
+}
+
 TEST(Service, UnfinishedJobsResumeAfterACoordinatorRestartAndFinishedOnesStayFetchable) {
     const fs::path state = freshDirectory("vrl-restart");
     const v1::JobSpec spec = makeSpec("path", 8, 4, 48, 32, 8);  // 24 tiles

@@ -5,6 +5,7 @@
 
 #include <spdlog/spdlog.h>
 
+#include <algorithm>
 #include <stdexcept>
 
 namespace vrl::worker {
@@ -16,7 +17,7 @@ AssetFetcher::AssetFetcher(std::shared_ptr<grpc::Channel> channel, std::string t
 std::string AssetFetcher::fetch(const std::string& sha256, uint64_t expectedSize) {
     auto stub = v1::WorkerGateway::NewStub(channel_);
     std::string blob;
-    blob.reserve(expectedSize);
+    blob.reserve(std::min<uint64_t>(expectedSize, uint64_t(64) << 20));  // grows with the data beyond that
     std::string problem;
     for (int attempt = 0; attempt < maxAttempts_; ++attempt) {
         if (attempt > 0) {

@@ -77,7 +77,10 @@ Worker::~Worker() {
 }
 
 void Worker::stop() {
-    stopping_ = true;
+    {
+        std::lock_guard lock(mutex_);  // so a sleeper cannot miss the wake-up
+        stopping_ = true;
+    }
     wake_.notify_all();
 }
 
@@ -118,7 +121,7 @@ void Worker::registerWorker() {
         const grpc::Status status = stub->Register(&context, request, &reply);
         if (status.ok()) {
             workerId_ = reply.worker_id();
-            heartbeatInterval_ = std::chrono::milliseconds(std::max<uint32_t>(10, reply.heartbeat_interval_ms()));
+            heartbeatIntervalMs_ = std::max<uint32_t>(10, reply.heartbeat_interval_ms());
             reregister_ = false;
             spdlog::info("registered with {} as {} ({} threads)", options_.coordinator, workerId_, options_.threads);
             if (healthServer_) healthServer_->GetHealthCheckService()->SetServingStatus(true);
@@ -163,10 +166,10 @@ void Worker::run() {
 
 void Worker::heartbeatLoop() {
     auto stub = v1::WorkerGateway::NewStub(channel_);
-    while (sleepUnlessStopping(heartbeatInterval_)) {
+    while (sleepUnlessStopping(std::chrono::milliseconds(heartbeatIntervalMs_.load()))) {
         if (killed_) return;
         grpc::ClientContext context;
-        rpc::prepareContext(context, options_.token, std::max(heartbeatInterval_ * 2, std::chrono::milliseconds(1000)));
+        rpc::prepareContext(context, options_.token, std::chrono::milliseconds(std::max<int64_t>(heartbeatIntervalMs_ * 2, 1000)));
         v1::HeartbeatRequest request;
         {
             std::lock_guard guard(registerMutex_);
@@ -209,16 +212,25 @@ std::shared_ptr<const Worker::JobContext> Worker::loadJob(const std::string& job
         if (!context->assets.ParseFromString(assetsBytes)) throw std::runtime_error("corrupt job description");
         const auto& assets = context->assets;
         const std::string& bundleSha = assets.spec().bundle_sha256();
+        if (bundleSha.size() != 64 || bundleSha.find_first_not_of("0123456789abcdef") != std::string::npos)
+            throw std::runtime_error("the coordinator named a malformed bundle hash");
+        if (assets.bundle_size() > options_.limits.maxBundleBytes)
+            throw std::runtime_error("the job's bundle exceeds this worker's bundle size limit");
         const fs::path bundleDir = cacheDir_ / "bundles" / bundleSha;
+        const fs::path marker = cacheDir_ / "bundles" / (bundleSha + ".scene");  // written once the bundle is whole
         fs::path sceneFile;
-        if (fs::exists(bundleDir / ".scene")) {
-            sceneFile = bundleDir / rpc::readFileText((bundleDir / ".scene").string());
+        if (fs::exists(marker)) {
+            sceneFile = bundleDir / rpc::readFileText(marker.string());
         } else {
             const std::string blob = fetcher_->fetch(bundleSha, assets.bundle_size());
             const v1::SceneBundle bundle = rpc::parseBundleBlob(blob, options_.limits);
             fs::create_directories(bundleDir.parent_path());
+            std::error_code error;
+            fs::remove_all(bundleDir, error);  // a half-written copy from a crash
             sceneFile = rpc::extractBundle(bundle, bundleDir);
-            std::ofstream(bundleDir / ".scene") << bundle.scene_path();
+            const fs::path partial = marker.string() + ".partial";
+            std::ofstream(partial) << bundle.scene_path();
+            fs::rename(partial, marker);
         }
         context->scene = rpc::loadJobScene(bundleDir, sceneFile, assets.spec(), options_.limits);
         if (context->scene.width != int(assets.width()) || context->scene.height != int(assets.height()) ||
@@ -283,6 +295,7 @@ void Worker::leaseLoop() {
             continue;
         }
         std::vector<std::string> unfinished;
+        std::string failure;  // why leases are given back, if not for stopping
         for (const auto& lease : reply.leases()) {
             if (stopping_ || killed_) {
                 unfinished.push_back(lease.lease_id());
@@ -296,6 +309,7 @@ void Worker::leaseLoop() {
                 job = loadJob(lease.job_id(), assetsBytes);
             } catch (const std::exception& e) {
                 spdlog::error("job {}: cannot load: {}", lease.job_id(), e.what());
+                failure = std::string("cannot load the job: ") + e.what();
                 unfinished.push_back(lease.lease_id());
                 sleepUnlessStopping(1s);
                 continue;
@@ -303,7 +317,15 @@ void Worker::leaseLoop() {
             const TileRect tile{int(lease.tile().x0()), int(lease.tile().y0()), int(lease.tile().x1()),
                                 int(lease.tile().y1())};
             const auto start = std::chrono::steady_clock::now();
-            const TileImages images = job->shader->renderTile(tile);
+            TileImages images;
+            try {
+                images = job->shader->renderTile(tile);
+            } catch (const std::exception& e) {
+                spdlog::error("job {}: shading a tile failed: {}", lease.job_id(), e.what());
+                failure = e.what();
+                unfinished.push_back(lease.lease_id());
+                continue;
+            }
             v1::TileResult result;
             result.set_worker_id(request.worker_id());
             result.set_lease_id(lease.lease_id());
@@ -340,6 +362,7 @@ void Worker::leaseLoop() {
             rpc::prepareContext(releaseContext, options_.token, 5s);
             v1::ReleaseRequest release;
             release.set_worker_id(request.worker_id());
+            release.set_failure(failure);
             for (const auto& id : unfinished) release.add_lease_ids(id);
             v1::ReleaseReply released;
             (void)stub->ReleaseLeases(&releaseContext, release, &released);

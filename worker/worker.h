@@ -80,7 +80,7 @@ private:
     std::filesystem::path cacheDir_;
     bool ownsCacheDir_ = false;
     std::string workerId_;
-    std::chrono::milliseconds heartbeatInterval_{2000};
+    std::atomic<int64_t> heartbeatIntervalMs_{2000};
     std::atomic<bool> stopping_{false}, killed_{false}, reregister_{false};
     mutable std::mutex mutex_;
     std::condition_variable wake_;

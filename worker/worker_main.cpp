@@ -6,6 +6,9 @@
 #include <spdlog/spdlog.h>
 
 #include <csignal>
+#include <cstdlib>
+#include <sys/prctl.h>
+#include <unistd.h>
 #include <thread>
 
 namespace vrl::worker {
@@ -47,6 +50,11 @@ int workerMain(int argc, char** argv) {
     sigaddset(&signals, SIGINT);
     sigaddset(&signals, SIGTERM);
     pthread_sigmask(SIG_BLOCK, &signals, nullptr);
+    // Started by `vrl render --workers`: stop (gracefully, via SIGTERM) when that process dies.
+    if (std::getenv("VRL_EXIT_WITH_PARENT")) {
+        prctl(PR_SET_PDEATHSIG, SIGTERM);
+        if (getppid() == 1) return 1;  // the parent is already gone
+    }
     try {
         options.token = rpc::loadToken(tokenFile);
         Worker worker(options);
