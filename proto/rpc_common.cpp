@@ -1,6 +1,8 @@
 #include "proto/rpc_common.h"
 
 #include <openssl/evp.h>
+#include <sys/prctl.h>
+#include <unistd.h>
 #include <zlib.h>
 
 #include <cstdlib>
@@ -125,6 +127,18 @@ std::string sha256Hex(std::string_view bytes) {
 uint32_t crc32Of(std::string_view bytes) {
     return static_cast<uint32_t>(
         crc32_z(crc32_z(0L, Z_NULL, 0), reinterpret_cast<const Bytef*>(bytes.data()), bytes.size()));
+}
+
+bool takeTerminationSignals(sigset_t& signals) {
+    sigemptyset(&signals);
+    sigaddset(&signals, SIGINT);
+    sigaddset(&signals, SIGTERM);
+    pthread_sigmask(SIG_BLOCK, &signals, nullptr);
+    if (std::getenv("VRL_EXIT_WITH_PARENT")) {
+        prctl(PR_SET_PDEATHSIG, SIGTERM);
+        if (getppid() == 1) return false;
+    }
+    return true;
 }
 
 std::string randomHex(size_t digits) {

@@ -5,6 +5,8 @@
 
 #include <grpcpp/grpcpp.h>
 
+#include <csignal>
+
 #include <chrono>
 #include <cstdint>
 #include <memory>
@@ -55,6 +57,12 @@ grpc::Status checkToken(const grpc::ServerContext& context, const std::string& e
 // Lowercase hex SHA-256 of bytes.
 std::string sha256Hex(std::string_view bytes);
 uint32_t crc32Of(std::string_view bytes);
+
+// For the server programs: blocks SIGINT and SIGTERM in this thread and every
+// thread started after (the caller takes them with sigwait on `signals`), and,
+// when VRL_EXIT_WITH_PARENT is set (children of `vrl render --workers`), asks
+// for SIGTERM when the parent dies. Returns false if the parent is already gone.
+bool takeTerminationSignals(sigset_t& signals);
 
 // `digits` random lowercase hex digits from std::random_device (ids, tokens).
 std::string randomHex(size_t digits);

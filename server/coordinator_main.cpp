@@ -7,9 +7,6 @@
 #include <tbb/global_control.h>
 
 #include <csignal>
-#include <cstdlib>
-#include <sys/prctl.h>
-#include <unistd.h>
 #include <fstream>
 #include <optional>
 
@@ -67,17 +64,8 @@ int coordinatorMain(int argc, char** argv) {
     options.heartbeatInterval = std::max(std::chrono::milliseconds(10), options.heartbeatTimeout / 5);
     options.limits.maxBundleBytes = maxBundleMiB << 20;
 
-    // SIGINT/SIGTERM are taken by sigwait below, in every thread started after this.
     sigset_t signals;
-    sigemptyset(&signals);
-    sigaddset(&signals, SIGINT);
-    sigaddset(&signals, SIGTERM);
-    pthread_sigmask(SIG_BLOCK, &signals, nullptr);
-    // Started by `vrl render --workers`: stop (gracefully, via SIGTERM) when that process dies.
-    if (std::getenv("VRL_EXIT_WITH_PARENT")) {
-        prctl(PR_SET_PDEATHSIG, SIGTERM);
-        if (getppid() == 1) return 1;  // the parent is already gone
-    }
+    if (!rpc::takeTerminationSignals(signals)) return 1;  // started by `vrl render --workers`, whose process is gone
 
     std::optional<tbb::global_control> threadLimit;
     if (threads > 0) threadLimit.emplace(tbb::global_control::max_allowed_parallelism, size_t(threads));

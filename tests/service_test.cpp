@@ -370,6 +370,22 @@ TEST(Service, ABundleIsUploadedOnceAndAWorkerDownloadsAJobsAssetsOnce) {
     EXPECT_EQ(stats.jobsLoaded, 1u);
 }
 
+// For tests that drive the Coordinator core directly, without gRPC.
+std::string storeDefaultBundle(server::Coordinator& coordinator) {
+    const std::string blob = collectSceneBundle(kScene, {});
+    const std::string sha = rpc::sha256Hex(blob);
+    coordinator.storeBundle(sha, blob);
+    return sha;
+}
+
+std::string registerTestWorker(server::Coordinator& coordinator) {
+    v1::RegisterRequest hello;
+    hello.set_protocol_version(rpc::kProtocolVersion);
+    hello.set_program_version(VRL_VERSION);
+    hello.set_threads(1);
+    return coordinator.registerWorker(hello).worker_id();
+}
+
 TEST(Service, TileResultsAreTakenOnceAndCheckedBeforeMerging) {
     const fs::path state = freshDirectory("vrl-coordinator-core");
     {
@@ -378,17 +394,11 @@ TEST(Service, TileResultsAreTakenOnceAndCheckedBeforeMerging) {
         options.leaseTimeout = 60s;
         options.heartbeatTimeout = 60s;
         server::Coordinator coordinator(options);
-        const std::string blob = collectSceneBundle(kScene, {});
-        const std::string sha = rpc::sha256Hex(blob);
-        coordinator.storeBundle(sha, blob);
+        const std::string sha = storeDefaultBundle(coordinator);
         v1::JobSpec spec = makeSpec("path", 1, 0, 16, 8, 8);  // two tiles
         spec.set_bundle_sha256(sha);
         const std::string id = coordinator.submitJob(spec);
-        v1::RegisterRequest hello;
-        hello.set_protocol_version(rpc::kProtocolVersion);
-        hello.set_program_version(VRL_VERSION);
-        hello.set_threads(1);
-        const std::string workerId = coordinator.registerWorker(hello).worker_id();
+        const std::string workerId = registerTestWorker(coordinator);
         v1::LeaseRequest ask;
         ask.set_worker_id(workerId);
         ask.set_max_tiles(4);
@@ -450,9 +460,7 @@ TEST(Service, AJobNoWorkerCanShadeFailsWithTheWorkersReasonAndForeignLeasesAreIg
         options.leaseTimeout = 60s;
         options.heartbeatTimeout = 60s;
         server::Coordinator coordinator(options);
-        const std::string blob = collectSceneBundle(kScene, {});
-        const std::string sha = rpc::sha256Hex(blob);
-        coordinator.storeBundle(sha, blob);
+        const std::string sha = storeDefaultBundle(coordinator);
         v1::JobSpec big = makeSpec("path", 1, 0, 64, 64, 8);  // 64 tiles
         big.set_bundle_sha256(sha);
         v1::JobSpec small = makeSpec("path", 1, 0, 8, 8, 8);  // 1 tile, higher priority: leased first
@@ -460,11 +468,7 @@ TEST(Service, AJobNoWorkerCanShadeFailsWithTheWorkersReasonAndForeignLeasesAreIg
         small.set_priority(1);
         const std::string bigId = coordinator.submitJob(big);
         const std::string smallId = coordinator.submitJob(small);
-        v1::RegisterRequest hello;
-        hello.set_protocol_version(rpc::kProtocolVersion);
-        hello.set_program_version(VRL_VERSION);
-        hello.set_threads(1);
-        const std::string workerId = coordinator.registerWorker(hello).worker_id();
+        const std::string workerId = registerTestWorker(coordinator);
         v1::LeaseRequest ask;
         ask.set_worker_id(workerId);
         ask.set_max_tiles(1);

@@ -6,8 +6,7 @@
 #include <spdlog/spdlog.h>
 
 #include <csignal>
-#include <cstdlib>
-#include <sys/prctl.h>
+#include <cstdio>
 #include <unistd.h>
 #include <thread>
 
@@ -46,15 +45,7 @@ int workerMain(int argc, char** argv) {
     }
     spdlog::set_level(spdlog::level::from_str(logLevel));
     sigset_t signals;
-    sigemptyset(&signals);
-    sigaddset(&signals, SIGINT);
-    sigaddset(&signals, SIGTERM);
-    pthread_sigmask(SIG_BLOCK, &signals, nullptr);
-    // Started by `vrl render --workers`: stop (gracefully, via SIGTERM) when that process dies.
-    if (std::getenv("VRL_EXIT_WITH_PARENT")) {
-        prctl(PR_SET_PDEATHSIG, SIGTERM);
-        if (getppid() == 1) return 1;  // the parent is already gone
-    }
+    if (!rpc::takeTerminationSignals(signals)) return 1;  // started by `vrl render --workers`, whose process is gone
     try {
         options.token = rpc::loadToken(tokenFile);
         Worker worker(options);
