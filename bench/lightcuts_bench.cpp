@@ -13,6 +13,7 @@
 #include "render/mitsuba_parser.h"
 #include "render/scene.h"
 #include "render/vrl_integrator.h"
+#include "render/timing.h"
 
 #include <CLI/CLI.hpp>
 #include <tbb/parallel_for.h>
@@ -24,10 +25,6 @@
 using namespace vrl;
 
 namespace {
-
-double secondsSince(std::chrono::steady_clock::time_point t) {
-    return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
-}
 
 struct Shading {
     Image image;

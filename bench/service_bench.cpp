@@ -11,6 +11,7 @@
 #include "proto/job_scene.h"
 #include "server/coordinator_service.h"
 #include "worker/asset_fetcher.h"
+#include "render/timing.h"
 
 #include <CLI/CLI.hpp>
 #include <spdlog/spdlog.h>
@@ -23,7 +24,6 @@
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
-#include <random>
 #include <thread>
 
 extern char** environ;
@@ -32,10 +32,6 @@ using namespace vrl;
 namespace fs = std::filesystem;
 
 namespace {
-
-double secondsSince(std::chrono::steady_clock::time_point t) {
-    return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
-}
 
 pid_t spawnWorker(const std::string& program, const std::string& address, int threads, int index) {
     const std::vector<std::string> arguments = {program, "--coordinator", address, "--threads", std::to_string(threads),
@@ -48,6 +44,29 @@ pid_t spawnWorker(const std::string& program, const std::string& address, int th
         throw std::runtime_error("cannot start " + program);
     return pid;
 }
+
+// A coordinator serving on 127.0.0.1:<free port> with a temporary state directory.
+struct LoopbackCoordinator {
+    explicit LoopbackCoordinator(const std::string& token)
+        : state(fs::temp_directory_path() / ("vrl-service-bench-" + rpc::randomHex(12))),
+          coordinator(optionsFor(state)),
+          server(coordinator, server::ServerOptions{"127.0.0.1:0", {}, token}),
+          address("127.0.0.1:" + std::to_string(server.port())) {}
+    ~LoopbackCoordinator() {
+        server.shutdown(std::chrono::milliseconds(0));
+        std::error_code error;
+        fs::remove_all(state, error);
+    }
+    static server::CoordinatorOptions optionsFor(const fs::path& state) {
+        server::CoordinatorOptions options;
+        options.stateDir = state;
+        return options;
+    }
+    fs::path state;
+    server::Coordinator coordinator;
+    server::CoordinatorServer server;
+    std::string address;
+};
 
 }  // namespace
 
@@ -94,20 +113,12 @@ int main(int argc, char** argv) {
     std::printf("%-22s %10s %10s %12s %12s\n", "run", "total s", "shading s", "efficiency", "overhead/tile");
     std::printf("%-22s %10.3f %10.3f %12s %12s\n", "embedded", embeddedTotal, embeddedShading, "1.000", "-");
 
-    std::random_device device;
-    const std::string token = std::to_string(device()) + std::to_string(device());
-    setenv("VRL_TOKEN", token.c_str(), 1);
+    const std::string token = rpc::randomHex(32);
+    setenv("VRL_TOKEN", token.c_str(), 1);  // the worker processes read it
     for (const int count : workerCounts) {
-        const fs::path state = fs::temp_directory_path() / ("vrl-service-bench-" + std::to_string(device()));
         {
-            server::CoordinatorOptions options;
-            options.stateDir = state;
-            server::Coordinator coordinator(options);
-            server::ServerOptions serverOptions;
-            serverOptions.listen = "127.0.0.1:0";
-            serverOptions.token = token;
-            server::CoordinatorServer server(coordinator, serverOptions);
-            const std::string address = "127.0.0.1:" + std::to_string(server.port());
+            LoopbackCoordinator local(token);
+            const std::string& address = local.address;
             std::vector<pid_t> workers;
             for (int w = 0; w < count; ++w)
                 workers.push_back(spawnWorker(workerProgram, address, std::max(1, cores / count), w + 1));
@@ -117,17 +128,13 @@ int main(int argc, char** argv) {
             v1::JobSpec submitted = spec;
             submitted.set_bundle_sha256(client.uploadBundle(collectSceneBundle(scene, {})));
             const std::string id = client.submit(submitted);
-            double renderingStart = 0.0;
-            const v1::JobProgress last = client.watch(id, [&](const v1::JobProgress& progress) {
-                if (progress.state() == v1::JOB_STATE_RENDERING && renderingStart == 0.0)
-                    renderingStart = secondsSince(start);
-            });
-            client.fetchImage(id, state / "image.exr");
+            const v1::JobProgress last = client.watch(id, {});
+            client.fetchImage(id, local.state / "image.exr");
             const double total = secondsSince(start);
             double shading = 0.0;
             for (const auto& phase : last.phases())
                 if (phase.phase() == "render") shading = phase.seconds();
-            const auto stats = coordinator.statistics();
+            const auto stats = local.coordinator.statistics();
             const double overhead = (stats.leaseSeconds + stats.submitSeconds) / double(std::max<uint64_t>(1, stats.tilesAccepted));
             char name[64];
             std::snprintf(name, sizeof name, "%d worker%s x %d thr", count, count > 1 ? "s" : "", std::max(1, cores / count));
@@ -135,24 +142,15 @@ int main(int argc, char** argv) {
                         overhead * 1e6);
             for (const pid_t pid : workers) kill(pid, SIGTERM);
             for (const pid_t pid : workers) waitpid(pid, nullptr, 0);
-            server.shutdown(std::chrono::milliseconds(0));
         }
-        std::error_code error;
-        fs::remove_all(state, error);
     }
 
     // Broadcast rate: a worker's verified download (chunks, CRC-32, SHA-256) of a serialised tree.
     {
-        const fs::path state = fs::temp_directory_path() / ("vrl-service-bench-" + std::to_string(device()));
         {
-            server::CoordinatorOptions options;
-            options.stateDir = state;
-            server::Coordinator coordinator(options);
-            server::ServerOptions serverOptions;
-            serverOptions.listen = "127.0.0.1:0";
-            server::CoordinatorServer server(coordinator, serverOptions);
-            const std::string address = "127.0.0.1:" + std::to_string(server.port());
-            JobClient client(address, {}, "");
+            LoopbackCoordinator local(token);
+            server::Coordinator& coordinator = local.coordinator;
+            JobClient client(local.address, {}, token);
             v1::JobSpec big = spec;
             big.mutable_parameters()->set_method("vrl-lightcuts");
             big.mutable_parameters()->set_vrl_count(std::max<uint64_t>(vrls, 200000));
@@ -170,7 +168,7 @@ int main(int argc, char** argv) {
                 lease = coordinator.leaseTiles(ask);
             }
             const auto& assets = lease.jobs(0);
-            worker::AssetFetcher fetcher(rpc::makeChannel(address, {}), "");
+            worker::AssetFetcher fetcher(rpc::makeChannel(local.address, {}), token);
             start = std::chrono::steady_clock::now();
             const std::string blob = fetcher.fetch(assets.lights_sha256(), assets.lights_size());
             const double seconds = secondsSince(start);
@@ -178,10 +176,7 @@ int main(int argc, char** argv) {
                         double(blob.size()) / 1e6, (unsigned long long)big.parameters().vrl_count(), seconds,
                         double(blob.size()) / 1e6 / seconds);
             coordinator.cancelJob(id);
-            server.shutdown(std::chrono::milliseconds(0));
         }
-        std::error_code error;
-        fs::remove_all(state, error);
     }
     return 0;
 }

@@ -2,6 +2,7 @@
 
 #include "client/job_client.h"
 #include "client/progress_bar.h"
+#include "render/timing.h"
 
 #include <spdlog/spdlog.h>
 
@@ -10,14 +11,6 @@
 #include <memory>
 
 namespace vrl {
-
-namespace {
-
-double secondsSince(std::chrono::steady_clock::time_point start) {
-    return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-}
-
-}  // namespace
 
 int runRemoteRender(const RenderCommandOptions& o, const RemoteOptions& remote) {
     const auto start = std::chrono::steady_clock::now();

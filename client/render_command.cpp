@@ -11,6 +11,7 @@
 #include "render/renderer.h"
 #include "render/scene.h"
 #include "render/vrl.h"
+#include "render/timing.h"
 
 #include <spdlog/spdlog.h>
 #include <sys/resource.h>
@@ -28,12 +29,6 @@
 namespace vrl {
 
 namespace {
-
-
-
-double secondsSince(std::chrono::steady_clock::time_point start) {
-    return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-}
 
 double peakMemoryMiB() {
     rusage usage{};

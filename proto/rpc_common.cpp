@@ -1,5 +1,6 @@
 #include "proto/rpc_common.h"
 
+#include <openssl/crypto.h>
 #include <openssl/evp.h>
 #include <sys/prctl.h>
 #include <unistd.h>
@@ -103,10 +104,9 @@ grpc::Status checkToken(const grpc::ServerContext& context, const std::string& e
     if (it == metadata.end())
         return {grpc::StatusCode::UNAUTHENTICATED,
                 "this coordinator requires a token (--token-file or VRL_TOKEN); the call carried none"};
-    const std::string_view given(it->second.data(), it->second.size());
-    unsigned char difference = given.size() == wanted.size() ? 0 : 1;
-    for (size_t i = 0; i < wanted.size(); ++i) difference |= uint8_t(wanted[i] ^ (i < given.size() ? given[i] : 0));
-    if (difference != 0) return {grpc::StatusCode::UNAUTHENTICATED, "wrong token"};
+    const bool same = it->second.size() == wanted.size() &&
+                      CRYPTO_memcmp(it->second.data(), wanted.data(), wanted.size()) == 0;  // constant time
+    if (!same) return {grpc::StatusCode::UNAUTHENTICATED, "wrong token"};
     return grpc::Status::OK;
 }
 

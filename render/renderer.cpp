@@ -3,6 +3,7 @@
 #include "render/light_tracer.h"
 #include "render/path_tracer.h"
 #include "render/vrl_integrator.h"
+#include "render/timing.h"
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
@@ -26,10 +27,6 @@ Ray cameraRay(const PerspectiveCamera& camera, const RenderSettings& settings, i
 
 bool isVrlMethod(const RenderSettings& settings) {
     return settings.method == "vrl" || settings.method == "vrl-lightcuts";
-}
-
-double secondsSince(std::chrono::steady_clock::time_point start) {
-    return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 
 }  // namespace

@@ -6,6 +6,7 @@
 #include "render/exr_io.h"
 #include "render/light_tree_io.h"
 #include "render/scene_error.h"
+#include "render/timing.h"
 
 #include <spdlog/spdlog.h>
 
@@ -21,8 +22,6 @@ namespace fs = std::filesystem;
 using Clock = std::chrono::steady_clock;
 
 namespace {
-
-double secondsSince(Clock::time_point start) { return std::chrono::duration<double>(Clock::now() - start).count(); }
 
 bool isTerminal(v1::JobState state) {
     return state == v1::JOB_STATE_DONE || state == v1::JOB_STATE_FAILED || state == v1::JOB_STATE_CANCELLED;

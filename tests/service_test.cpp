@@ -370,13 +370,28 @@ TEST(Service, ABundleIsUploadedOnceAndAWorkerDownloadsAJobsAssetsOnce) {
     EXPECT_EQ(stats.jobsLoaded, 1u);
 }
 
-// For tests that drive the Coordinator core directly, without gRPC.
-std::string storeDefaultBundle(server::Coordinator& coordinator) {
-    const std::string blob = collectSceneBundle(kScene, {});
-    const std::string sha = rpc::sha256Hex(blob);
-    coordinator.storeBundle(sha, blob);
-    return sha;
-}
+// The Coordinator core without gRPC, holding the default scene's bundle; leases
+// and workers never time out, so a test drives every step itself.
+struct CoreCoordinator {
+    CoreCoordinator() {
+        options = Cluster::fastOptions();
+        options.stateDir = freshDirectory("vrl-coordinator-core");
+        options.leaseTimeout = 60s;
+        options.heartbeatTimeout = 60s;
+        coordinator = std::make_unique<server::Coordinator>(options);
+        const std::string blob = collectSceneBundle(kScene, {});
+        sha = rpc::sha256Hex(blob);
+        coordinator->storeBundle(sha, blob);
+    }
+    ~CoreCoordinator() {
+        coordinator.reset();
+        std::error_code error;
+        fs::remove_all(options.stateDir, error);
+    }
+    server::CoordinatorOptions options;
+    std::unique_ptr<server::Coordinator> coordinator;
+    std::string sha;
+};
 
 std::string registerTestWorker(server::Coordinator& coordinator) {
     v1::RegisterRequest hello;
@@ -387,14 +402,10 @@ std::string registerTestWorker(server::Coordinator& coordinator) {
 }
 
 TEST(Service, TileResultsAreTakenOnceAndCheckedBeforeMerging) {
-    const fs::path state = freshDirectory("vrl-coordinator-core");
     {
-        server::CoordinatorOptions options = Cluster::fastOptions();
-        options.stateDir = state;
-        options.leaseTimeout = 60s;
-        options.heartbeatTimeout = 60s;
-        server::Coordinator coordinator(options);
-        const std::string sha = storeDefaultBundle(coordinator);
+        CoreCoordinator core;
+        server::Coordinator& coordinator = *core.coordinator;
+        const std::string sha = core.sha;
         v1::JobSpec spec = makeSpec("path", 1, 0, 16, 8, 8);  // two tiles
         spec.set_bundle_sha256(sha);
         const std::string id = coordinator.submitJob(spec);
@@ -448,19 +459,14 @@ TEST(Service, TileResultsAreTakenOnceAndCheckedBeforeMerging) {
         EXPECT_EQ(image.image.at(0, 0).x, 0.25f);
         EXPECT_EQ(image.image.at(12, 3).y, 1.0f);
     }
-    std::error_code error;
-    fs::remove_all(state, error);
 }
 
 TEST(Service, AJobNoWorkerCanShadeFailsWithTheWorkersReasonAndForeignLeasesAreIgnored) {
-    const fs::path state = freshDirectory("vrl-coordinator-failures");
     {
-        server::CoordinatorOptions options = Cluster::fastOptions();
-        options.stateDir = state;
-        options.leaseTimeout = 60s;
-        options.heartbeatTimeout = 60s;
-        server::Coordinator coordinator(options);
-        const std::string sha = storeDefaultBundle(coordinator);
+        CoreCoordinator core;
+        server::Coordinator& coordinator = *core.coordinator;
+        const server::CoordinatorOptions& options = core.options;
+        const std::string sha = core.sha;
         v1::JobSpec big = makeSpec("path", 1, 0, 64, 64, 8);  // 64 tiles
         big.set_bundle_sha256(sha);
         v1::JobSpec small = makeSpec("path", 1, 0, 8, 8, 8);  // 1 tile, higher priority: leased first
@@ -509,8 +515,6 @@ TEST(Service, AJobNoWorkerCanShadeFailsWithTheWorkersReasonAndForeignLeasesAreIg
             << failed.message();
         EXPECT_EQ(coordinator.jobProgress(bigId).state(), v1::JOB_STATE_RENDERING);
     }
-    std::error_code error;
-    fs::remove_all(state, error);
 }
 
 TEST(Service, UnfinishedJobsResumeAfterACoordinatorRestartAndFinishedOnesStayFetchable) {
