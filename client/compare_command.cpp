@@ -23,6 +23,7 @@ void registerCompareCommand(CLI::App& app, int& exitCode) {
         "  RMSE          = sqrt(mean((I - R)^2))\n"
         "  relative RMSE = sqrt(mean((I - R)^2 / (R^2 + 0.01)))\n"
         "  SMAPE         = (2/n) sum |R - I| / (R + I + 0.01)   (Vibert et al. 2019)\n"
+        "  mean luminance of the image, of the reference, and their ratio\n"
         "Exits 1 when the sizes differ or a file cannot be read.");
     cmd->callback([paths, exact, &exitCode] {
         try {
@@ -33,6 +34,8 @@ void registerCompareCommand(CLI::App& app, int& exitCode) {
             std::printf("RMSE           %.6g\n", m.rmse);
             std::printf("relative RMSE  %.6g\n", m.relativeRmse);
             std::printf("SMAPE          %.6g\n", m.smape);
+            std::printf("mean luminance %.6g (reference %.6g, ratio %.4f)\n", m.meanTest, m.meanReference,
+                        m.meanReference != 0.0 ? m.meanTest / m.meanReference : 0.0);
             if (m.nonFinitePixels > 0) {
                 std::printf("non-finite     %zu pixels (excluded from the sums)\n", m.nonFinitePixels);
                 exitCode = 1;

@@ -2,6 +2,8 @@
 
 #include "client/job_client.h"
 #include "client/progress_bar.h"
+#include "render/exr_io.h"
+#include "render/preview_image.h"
 #include "render/timing.h"
 
 #include <spdlog/spdlog.h>
@@ -24,6 +26,7 @@ int runRemoteRender(const RenderCommandOptions& o, const RemoteOptions& remote) 
         spec.set_tile_size(o.tileSize);
         spec.set_priority(remote.priority);
         spec.set_name(o.scene);
+        spec.set_medium(o.medium);
         const std::string blob = collectSceneBundle(o.scene, defines);
         bool uploaded = false;
         spec.set_bundle_sha256(client.uploadBundle(blob, &uploaded));
@@ -66,6 +69,10 @@ int runRemoteRender(const RenderCommandOptions& o, const RemoteOptions& remote) 
         return 1;
     }
     client.fetchImage(jobId, o.output);
+    if (!o.preview.empty()) {
+        const ImageSet images = readExr(o.output);
+        writePreviewPng(images.image, o.preview, autoExposure(images.image));
+    }
     std::fprintf(stderr, "summary: job %s, %u tiles, %.3f s in all -> %s\n", jobId.c_str(), last.tiles_total(),
                  secondsSince(start), o.output.c_str());
     for (const auto& phase : last.phases()) std::fprintf(stderr, "  %-18s %8.3f s\n", phase.phase().c_str(), phase.seconds());

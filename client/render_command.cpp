@@ -7,6 +7,8 @@
 #include "proto/scene_bundle.h"
 
 #include "render/exr_io.h"
+#include "render/medium_fill.h"
+#include "render/preview_image.h"
 #include "render/mitsuba_parser.h"
 #include "render/renderer.h"
 #include "render/scene.h"
@@ -93,6 +95,14 @@ int runRender(const RenderCommandOptions& o) {
 
     auto t0 = Clock::now();
     SceneDescription description = parseMitsubaScene(o.scene, parseOptions);
+    if (!o.medium.empty()) {
+        try {
+            fillWithMedium(description, parseFillMedium(o.medium));
+        } catch (const std::invalid_argument& e) {
+            std::fprintf(stderr, "vrl render: error: %s\n", e.what());
+            return 2;
+        }
+    }
     if (!o.resolution.empty()) {
         std::smatch match;
         const std::regex pattern("^([0-9]{1,9})x([0-9]{1,9})$");
@@ -168,6 +178,8 @@ int runRender(const RenderCommandOptions& o) {
     std::string defines;
     for (const auto& d : o.defines) defines += (defines.empty() ? "" : " ") + d;
     images.metadata["vrl.defines"] = defines;
+    addSceneNotes(description, images.metadata);
+    if (!o.medium.empty()) images.metadata["vrl.medium"] = o.medium;
     images.metadata["vrl.time.parse"] = std::to_string(parseSeconds);
     images.metadata["vrl.time.build"] = std::to_string(buildSeconds);
     images.metadata["vrl.time.render"] = std::to_string(stats.seconds);
@@ -187,6 +199,7 @@ int runRender(const RenderCommandOptions& o) {
         images.metadata["vrl.time.lightTracing"] = std::to_string(stats.tracingSeconds);
     }
     writeExr(o.output, images);
+    if (!o.preview.empty()) writePreviewPng(images.image, o.preview, autoExposure(images.image));
     const double writeSeconds = secondsSince(t0);
 
     std::fprintf(stderr,

@@ -12,6 +12,13 @@ void addRenderOptions(CLI::App& cmd, RenderCommandOptions& o) {
     cmd.add_option("scene", o.scene, "Scene file (Mitsuba 0.5/0.6 XML subset)")->required();
     cmd.add_option("-o,--output", o.output, "Output OpenEXR file")->required();
     cmd.add_option("-D,--define", o.defines, "Override a scene <default>: -D name=value (repeatable)");
+    cmd.add_option("--medium", o.medium,
+                    "Fill a scene that has no medium with a homogeneous one, as the paper did for its benchmarks: "
+                    "\"sigmaS=S,sigmaA=A[,g=G]\" (per scene unit; S and A one value or r:g:b; g: Henyey-Greenstein, "
+                    "default 0 = isotropic). The camera and every light sit in it");
+    cmd.add_option("--preview", o.preview,
+                    "Also write a tone-mapped 8-bit PNG of the image here (automatic exposure: the 99th percentile "
+                    "of luminance maps near white)");
     cmd.add_option("--method", o.method,
                     "Rendering method: path (volumetric path tracer, the reference), vrl (transport parts "
                     "(a)-(c) by path sampling, multiple scattering (d) by plain VRLs) or vrl-lightcuts (the same, "

@@ -17,6 +17,8 @@ struct RenderCommandOptions {
     std::string scene;
     std::string output;
     std::vector<std::string> defines;
+    std::string medium;   // --medium "sigmaS=..,sigmaA=..[,g=..]": fill a scene without media
+    std::string preview;  // --preview out.png: a tone-mapped PNG beside the EXR
     std::string method = "path";
     int spp = 0;  // 0: the scene's sampleCount
     std::string resolution;  // "WxH", empty: the scene's film

@@ -1,5 +1,7 @@
 #include "proto/job_scene.h"
 
+#include "render/medium_fill.h"
+
 #include "render/mitsuba_parser.h"
 #include "render/scene_description.h"
 
@@ -53,7 +55,9 @@ void validateJobSpec(const v1::JobSpec& spec, const ServiceLimits& limits) {
     if ((p.width() == 0) != (p.height() == 0)) throw JobSpecError("give both width and height, or neither");
     for (const auto& [name, value] : spec.defines())
         if (name.empty() || name.size() > 256 || value.size() > 4096) throw JobSpecError("invalid define '" + name + "'");
+    if (spec.medium().size() > 1024) throw JobSpecError("the fill medium description is longer than 1024 bytes");
     try {
+        if (!spec.medium().empty()) (void)parseFillMedium(spec.medium());
         (void)TransportSelection::parse(p.transport());
     } catch (const std::exception& e) {
         throw JobSpecError(e.what());
@@ -68,6 +72,7 @@ JobScene loadJobScene(const std::filesystem::path& bundleDirectory, const std::f
     options.defines.insert(spec.defines().begin(), spec.defines().end());
     options.confineTo = bundleDirectory;
     SceneDescription description = parseMitsubaScene(sceneFile, options);
+    if (!spec.medium().empty()) fillWithMedium(description, parseFillMedium(spec.medium()));
     if (p.width() > 0) {
         description.sensor.width = int(std::min<uint32_t>(p.width(), 1u << 30));
         description.sensor.height = int(std::min<uint32_t>(p.height(), 1u << 30));

@@ -1,29 +1,45 @@
 #include "render/camera_segment.h"
 
+#include "render/rng.h"
 #include "render/scene.h"
 
 namespace vrl {
 
-std::vector<CameraSegment> cameraSegments(const Scene& scene, const Ray& cameraRay, int medium,
-                                          Rgb* transmittanceToEnd) {
+std::vector<CameraSegment> cameraSegments(const Scene& scene, const Ray& cameraRay, int medium, Rng* rng,
+                                          int maxDepth) {
     std::vector<CameraSegment> segments;
     Ray ray = cameraRay;
-    Rgb transmittance(1.0f);
+    Rgb throughput(1.0f);
+    int specular = 0;
     float segmentStart = ray.tMin;
     for (int crossings = 0; crossings < 256; ++crossings) {
         const auto hit = scene.intersect(ray);
         const float end = hit ? hit->t : ray.tMax;
         if (medium >= 0 && end > segmentStart) {
             const float length = std::isfinite(end) ? end - segmentStart : 1e30f;
-            segments.push_back({ray.at(segmentStart), ray.direction, length, medium, transmittance});
-            transmittance *= scene.media()[medium].transmittance(end - segmentStart);
+            segments.push_back({ray.at(segmentStart), ray.direction, length, medium, throughput, specular});
+            throughput *= scene.media()[medium].transmittance(end - segmentStart);
         }
-        if (!hit || !scene.shapes()[hit->shape].bsdf.isNull()) break;
-        medium = scene.mediumAfter(*hit, ray.direction, medium);
-        segmentStart = hit->t;
-        Scene::continuePast(ray, *hit);
+        if (!hit) break;
+        const Bsdf& bsdf = scene.shapes()[hit->shape].bsdf;
+        if (bsdf.isNull()) {
+            medium = scene.mediumAfter(*hit, ray.direction, medium);
+            segmentStart = hit->t;
+            Scene::continuePast(ray, *hit);
+            continue;
+        }
+        // A specular bounce is a path vertex: the next segment needs room for two more.
+        if (!rng || !bsdf.isPurelySpecular() || specular >= kMaxSpecularChain) break;
+        if (maxDepth >= 0 && specular + 2 > maxDepth) break;
+        const auto sampled = bsdf.sample(hit->shadingPoint(), -ray.direction, Vec2(rng->next(), rng->next()),
+                                         rng->next(), TransportMode::Radiance);
+        if (!sampled || isBlack(sampled->weight)) break;
+        throughput *= sampled->weight;
+        ++specular;
+        medium = scene.mediumAfter(*hit, sampled->wi, medium);
+        ray = Ray{Scene::offsetOrigin(*hit, sampled->wi), sampled->wi};
+        segmentStart = 0.0f;
     }
-    if (transmittanceToEnd) *transmittanceToEnd = transmittance;
     return segments;
 }
 

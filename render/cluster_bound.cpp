@@ -134,7 +134,7 @@ Rgb ClusterBound::bound(int32_t index, const CameraSegment& segment, bool* lineC
     // The node is estimated by its representative with flux Phi_C: the bound's
     // Phi L factor is Phi_C L_rep = the node's flux x length (<= Phi_C L_max, Eq. 11's).
     const double scale = kRoundingMargin * phase * maxSubtendedAngle(segment.length, h) / h;
-    return node.fluxLength * sigmaSV * cameraMedium.sigmaS() * segment.transmittanceBefore * between * float(scale);
+    return node.fluxLength * sigmaSV * cameraMedium.sigmaS() * segment.throughputBefore * between * float(scale);
 }
 
 }  // namespace vrl

@@ -22,6 +22,7 @@ struct ImageErrorMetrics {
     double rmse = 0.0;
     double relativeRmse = 0.0;
     double smape = 0.0;
+    double meanReference = 0.0, meanTest = 0.0;  // mean luminances over the compared pixels
     size_t pixels = 0;           // n: pixels compared (those with a finite test value)
     size_t nonFinitePixels = 0;  // test pixels with a NaN or infinite component, left out of the sums
 };

@@ -101,22 +101,13 @@ public:
                 continue;
             }
             if (Scene::withinCrossing(ray, *hit)) medium = mediumBeforeCrossing;
-            // Diffuse bounce sampled about the geometric normal. The camera side shades
-            // with the shading normal, f cos_s(wi); as an adjoint the light path carries
-            // albedo x cos_s(wi) / cos_g(wi) (Veach 1997, wi towards the light).
-            Vec3 n = hit->geometricNormal;
-            Vec3 shadingNormal = hit->shadingNormal;
-            const bool front = ray.direction.dot(hit->geometricNormal) < 0.0f;
-            if (!front) {
-                if (!shape.bsdf.twoSided) return;
-                n = -n;
-                shadingNormal = -shadingNormal;
-            }
-            const float cosShading = -ray.direction.dot(shadingNormal), cosGeometric = -ray.direction.dot(n);
-            if (!(cosShading > 0.0f) || !(cosGeometric > 0.0f)) return;
+            // The adjoint BSDF (Importance mode) carries the shading-normal correction.
             ++vertices;
-            const Vec3 dir = Frame::fromNormal(n).toWorld(cosineHemisphere(Vec2(rng.next(), rng.next()))).normalized();
-            throughput *= shape.bsdf.reflectance * (cosShading / cosGeometric);
+            const auto sampled = shape.bsdf.sample(hit->shadingPoint(), -ray.direction, Vec2(rng.next(), rng.next()),
+                                                   rng.next(), TransportMode::Importance);
+            if (!sampled || isBlack(sampled->weight) || !isFinite(sampled->weight)) return;
+            throughput *= sampled->weight;
+            const Vec3 dir = sampled->wi;
             medium = scene_.mediumAfter(*hit, dir, medium);
             ray = Ray{Scene::offsetOrigin(*hit, dir), dir};
             segmentStart = 0.0f;

@@ -9,22 +9,37 @@
 #include <memory>
 #include <numbers>
 
+#include "render/mitsuba_bsdf_parser.h"
+#include "render/mitsuba_parse_context.h"
 #include "render/xml_values.h"
 
 namespace vrl {
 namespace {
 
+using mitsuba::formatRgb;
+using mitsuba::lowercase;
+using mitsuba::NamedObject;
+using mitsuba::nonNegativeColor;
+using mitsuba::pluginName;
+using mitsuba::pluginType;
 using xml::Element;
 using xml::ParamSpec;
 using xml::PluginParams;
 
 // ---------------------------------------------------------------- plugin tables
 // Each plugin's parameters and how they are used; extend a table to accept more.
+// Bsdfs and textures: mitsuba_bsdf_parser.cpp.
 using T = xml::ParamType;
 using U = xml::ParamUse;
 // clang-format off
+// Integrators this renderer implements (the rendering method still comes from
+// --method), then the other Mitsuba 0.5/0.6 integrators: accepted, their
+// parameters listed in SceneDescription::ignored, only maxDepth read.
 constexpr std::string_view kIntegratorTypes[] = {
-    "volpath", "volpath_simple", "path", "direct", "vrl", "vrlcuts", "vpl"};
+    "volpath", "volpath_simple", "path", "direct", "vrl", "vrlcuts",
+    "ao", "bdpt", "photonmapper", "ppm", "sppm", "pssmlt", "mlt", "erpt", "ptracer", "vpl",
+    "adaptive", "irrcache", "multichannel", "field"};
+constexpr size_t kOwnIntegratorCount = 6;
 constexpr ParamSpec kIntegratorParameters[] = {
     {"maxDepth", T::Integer}, {"rrDepth", T::Integer, U::Ignore},
     {"strictNormals", T::Boolean, U::Ignore}, {"hideEmitters", T::Boolean, U::Ignore},
@@ -46,23 +61,27 @@ constexpr ParamSpec kFilmParameters[] = {
     {"key", T::Float, U::Ignore}, {"burn", T::Float, U::Ignore},
     {"cropOffsetX", T::Integer, U::Unsupported}, {"cropOffsetY", T::Integer, U::Unsupported},
     {"cropWidth", T::Integer, U::Unsupported}, {"cropHeight", T::Integer, U::Unsupported}};
+constexpr std::string_view kRfilterTypes[] = {"box", "tent", "gaussian", "mitchell", "catmullrom", "lanczos"};
+constexpr ParamSpec kRfilterParameters[] = {
+    {"radius", T::Float, U::Ignore}, {"stddev", T::Float, U::Ignore}, {"B", T::Float, U::Ignore},
+    {"C", T::Float, U::Ignore}, {"lobes", T::Integer, U::Ignore}};
 
 // All treated as independent sampling with `sampleCount` samples per pixel.
 constexpr std::string_view kSamplerTypes[] = {"independent", "ldsampler", "stratified", "halton", "sobol"};
 constexpr ParamSpec kSamplerParameters[] = {
     {"sampleCount", T::Integer}, {"scramble", T::Integer, U::Ignore}, {"dimension", T::Integer, U::Ignore}};
 
-constexpr std::string_view kBsdfTypes[] = {"diffuse", "null", "twosided"};
-constexpr ParamSpec kDiffuseParameters[] = {{"reflectance", T::Color}};
-
 // In ShapeDescription::Kind order.
-constexpr std::string_view kShapeTypes[] = {"obj", "rectangle", "cube", "sphere", "disk"};
+constexpr std::string_view kShapeTypes[] = {"obj", "rectangle", "cube", "sphere", "disk", "serialized"};
 constexpr ParamSpec kBasicShapeParameters[] = {{"toWorld", T::Transform}, {"flipNormals", T::Boolean}};
 constexpr ParamSpec kSphereParameters[] = {
     {"toWorld", T::Transform}, {"flipNormals", T::Boolean}, {"center", T::Point}, {"radius", T::Float}};
 constexpr ParamSpec kObjParameters[] = {
     {"filename", T::String}, {"toWorld", T::Transform}, {"flipNormals", T::Boolean}, {"faceNormals", T::Boolean},
     {"flipTexCoords", T::Boolean, U::Ignore}, {"maxSmoothAngle", T::Float, U::Unsupported}};
+constexpr ParamSpec kSerializedParameters[] = {
+    {"filename", T::String}, {"shapeIndex", T::Integer}, {"toWorld", T::Transform}, {"flipNormals", T::Boolean},
+    {"faceNormals", T::Boolean}, {"maxSmoothAngle", T::Float, U::Ignore}};
 
 constexpr std::string_view kShapeEmitterTypes[] = {"area"};
 constexpr ParamSpec kAreaParameters[] = {{"radiance", T::Color}, {"samplingWeight", T::Float, U::Ignore}};
@@ -83,42 +102,17 @@ constexpr std::string_view kPhaseTypes[] = {"isotropic", "hg"};
 constexpr ParamSpec kHgParameters[] = {{"g", T::Float}};
 
 constexpr std::string_view kSceneChildren[] = {
-    "default", "include", "integrator", "sensor", "shape", "bsdf", "medium", "emitter"};
+    "default", "include", "integrator", "sensor", "shape", "bsdf", "texture", "medium", "emitter"};
 constexpr std::string_view kFovAxes[] = {"x", "y", "diagonal", "smaller", "larger"};  // FovAxis order
 // clang-format on
 
 constexpr int kMaxIncludeDepth = 64;
+constexpr const char* kSamplingWeightReason = "emitters are chosen by power (light tree), not by samplingWeight";
 
-// ---------------------------------------------------------------- helpers
-
-std::string lowercase(std::string text) {
-    std::transform(text.begin(), text.end(), text.begin(), [](unsigned char c) { return std::tolower(c); });
-    return text;
-}
-
-std::string formatRgb(const Rgb& c) { return fmt::format("({}, {}, {})", c.x, c.y, c.z); }
-
-// The plugin's `type` attribute, lower-cased as Mitsuba does; fails on a type not in `valid`.
-std::string pluginType(const Element& element, std::span<const std::string_view> valid,
-                       std::string_view extraHint = {}) {
-    element.checkAttributes({"type", "id", "name"});
-    const std::string type = lowercase(element.requireAttribute("type"));
-    if (std::find(valid.begin(), valid.end(), type) == valid.end())
-        element.fail("unknown " + element.tag() + " type '" + type + "'; valid types: " + xml::joinNames(valid) +
-                     std::string(extraHint));
-    return type;
-}
-
-std::string pluginName(const Element& element, const std::string& type) {
-    return element.tag() + " type '" + type + "'";
-}
-
-Rgb nonNegativeColor(const PluginParams& params, std::string_view name, const Rgb& fallback) {
-    const auto color = params.getColor(name);
-    if (!color) return fallback;
-    if (minComponent(*color) < 0.0f)
-        params.fail(name, "'" + std::string(name) + "' must be non-negative, got " + formatRgb(*color));
-    return *color;
+// Mitsuba's maxDepth: -1 (unlimited) or a path length of at least 1.
+void checkMaxDepth(const Element& at, int maxDepth) {
+    if (maxDepth != -1 && maxDepth < 1)
+        at.fail("maxDepth must be -1 (unlimited) or at least 1, got " + std::to_string(maxDepth));
 }
 
 // ---------------------------------------------------------------- the parser
@@ -126,53 +120,40 @@ Rgb nonNegativeColor(const PluginParams& params, std::string_view name, const Rg
 class SceneParser {
 public:
     explicit SceneParser(const ParseOptions& options)
-        : defines_(options.defines.begin(), options.defines.end()),
-          confineTo_(options.confineTo),
-          onFileReferenced_(options.onFileReferenced) {}
+        : defines_(options.defines.begin(), options.defines.end()), context_(options) {}
 
     SceneDescription parse(std::unique_ptr<xml::XmlFile> file, const std::filesystem::path& identity,
                            std::optional<std::filesystem::path> canonicalPath);
 
 private:
-    // An object declared with an id (bsdf and medium can be referenced).
-    struct Named {
-        std::string tag;
-        std::optional<BsdfDescription> bsdf;
-        int medium = -1;
-        SourceLocation where;
-    };
-
     void parseSceneChildren(const Element& scene);
     void parseDefault(const Element& element);
     void parseInclude(const Element& element);
     void parseIntegrator(const Element& element);
+    // Mitsuba integrators this renderer does not implement: accepts any
+    // parameters (listed in `parameters`) and nested integrators.
+    void parseForeignIntegrator(const Element& element, const std::string& prefix, std::vector<std::string>& parameters,
+                                std::optional<int>& maxDepth);
     void parseSensor(const Element& element);
     void parseFilm(const Element& element, SensorDescription& sensor);
     void parseSampler(const Element& element, SensorDescription& sensor);
-    BsdfDescription parseBsdf(const Element& element);
     int parseMedium(const Element& element);
     PhaseDescription parsePhase(const Element& element);
     void parseShape(const Element& element);
     Rgb parseAreaEmitter(const Element& element);
     EmitterDescription parseEmitter(const Element& element);
 
-    // Records element's id (if any) for <ref> and duplicate checks.
-    void registerId(const Element& element, std::optional<BsdfDescription> bsdf = {}, int medium = -1);
-    const Named& lookup(const Element& ref);
-    BsdfDescription referencedBsdf(const Element& ref);
+    void registerId(const Element& element, NamedObject object = {}) {
+        context_.registerId(element, std::move(object));
+    }
     int referencedMedium(const Element& ref);
     int mediumChild(const Element& child, int current);  // nested <medium> or <ref> to one
 
-    // Applies ParseOptions::confineTo and ::onFileReferenced to a referenced file.
-    void checkReference(const Element& element, const std::filesystem::path& path) const;
-
     xml::Defines defines_;
-    std::optional<std::filesystem::path> confineTo_;
-    std::function<void(const std::filesystem::path&)> onFileReferenced_;
+    mitsuba::ParseContext context_;
+    SceneDescription& scene_ = context_.scene();
     std::vector<std::unique_ptr<xml::XmlFile>> files_;  // alive while their elements are in use
     std::vector<std::filesystem::path> includeStack_;   // canonical paths, for cycle detection
-    std::map<std::string, Named> ids_;
-    SceneDescription scene_;
     std::optional<SourceLocation> sensorAt_, integratorAt_;
 };
 
@@ -198,7 +179,7 @@ SceneDescription SceneParser::parse(std::unique_ptr<xml::XmlFile> file, const st
     if (!sensorAt_) spdlog::warn("{}: the scene has no <sensor>; using the default camera", identity.string());
     if (!integratorAt_)
         spdlog::debug("{}: the scene has no <integrator>; using {}", identity.string(), scene_.integrator.type);
-    return std::move(scene_);
+    return context_.finish();
 }
 
 void SceneParser::parseSceneChildren(const Element& scene) {
@@ -214,37 +195,20 @@ void SceneParser::parseSceneChildren(const Element& scene) {
             parseSensor(child);
         } else if (tag == "shape") {
             parseShape(child);
-        } else if (tag == "bsdf") {
-            parseBsdf(child);
+        } else if (tag == "bsdf" || tag == "texture" || tag == "medium") {
+            if (tag == "bsdf") mitsuba::parseBsdf(context_, child);
+            if (tag == "texture") mitsuba::parseTexture(context_, child);
+            if (tag == "medium") parseMedium(child);
             if (!child.has("id"))
-                spdlog::warn("{}: a top-level <bsdf> without an id is never used", child.where().describe());
-        } else if (tag == "medium") {
-            parseMedium(child);
-            if (!child.has("id"))
-                spdlog::warn("{}: a top-level <medium> without an id is never used", child.where().describe());
+                spdlog::warn("{}: a top-level <{}> without an id is never used", child.where().describe(), tag);
         } else if (tag == "emitter") {
             if (lowercase(child.attribute("type").value_or("")) == "area")
                 child.fail("attach area emitters to a shape (put the <emitter type=\"area\"> inside a <shape>)");
             scene_.emitters.push_back(parseEmitter(child));
-        } else if (tag == "texture") {
-            child.fail("<texture> is not supported yet");
         } else {
             child.fail("unknown element <" + tag + "> in <scene>; valid here: " + xml::joinNames(kSceneChildren));
         }
     }
-}
-
-void SceneParser::checkReference(const Element& element, const std::filesystem::path& path) const {
-    if (confineTo_) {
-        std::error_code error;
-        const auto root = std::filesystem::weakly_canonical(*confineTo_, error);
-        const auto target = std::filesystem::weakly_canonical(path, error);
-        const auto relative = target.lexically_relative(root);
-        if (error || relative.empty() || *relative.begin() == ".." || relative.is_absolute())
-            element.fail("'" + path.string() + "' lies outside the scene bundle; a bundled scene may only reference "
-                         "files inside it");
-    }
-    if (onFileReferenced_) onFileReferenced_(path);
 }
 
 void SceneParser::parseDefault(const Element& element) {
@@ -261,7 +225,7 @@ void SceneParser::parseDefault(const Element& element) {
 void SceneParser::parseInclude(const Element& element) {
     element.checkAttributes({"filename"});
     const std::filesystem::path path = element.resolvePath(element.requireAttribute("filename"));
-    checkReference(element, path);
+    context_.checkReference(element, path);
     const std::string text = xml::readTextFile(path, element.where(), "included file");
     std::error_code error;
     const std::filesystem::path canonical = std::filesystem::weakly_canonical(path, error);
@@ -278,23 +242,59 @@ void SceneParser::parseInclude(const Element& element) {
     parseSceneChildren(root);
     includeStack_.pop_back();
 }
-
 void SceneParser::parseIntegrator(const Element& element) {
     if (integratorAt_)
         element.fail("a scene has only one <integrator> (the first is on line " + std::to_string(integratorAt_->line) +
                      ")");
     const std::string type = pluginType(element, kIntegratorTypes);
     registerId(element);
-    const PluginParams params(element, pluginName(element, type), kIntegratorParameters, {});
     IntegratorDescription& integrator = scene_.integrator;
     integrator.type = type;
-    if (const auto maxDepth = params.getInteger("maxDepth")) {
-        if (*maxDepth != -1 && *maxDepth < 1)
-            params.fail("maxDepth", "maxDepth must be -1 (unlimited) or at least 1, got " + std::to_string(*maxDepth));
-        integrator.maxDepth = *maxDepth;
-    }
     integrator.where = element.where();
     integratorAt_ = integrator.where;
+    const bool own = std::find(std::begin(kIntegratorTypes), std::begin(kIntegratorTypes) + kOwnIntegratorCount,
+                               type) != std::begin(kIntegratorTypes) + kOwnIntegratorCount;
+    std::optional<int> maxDepth;
+    if (own) {
+        const PluginParams params(element, pluginName(element, type), kIntegratorParameters, {});
+        context_.reportIgnoredParameters(params, element, type, "no effect in this renderer");
+        maxDepth = params.getInteger("maxDepth");
+        if (maxDepth) checkMaxDepth(*params.element("maxDepth"), *maxDepth);
+    } else {
+        std::vector<std::string> parameters;
+        parseForeignIntegrator(element, "", parameters, maxDepth);
+        context_.reportIgnored(element, type, "rendering uses --method; only maxDepth is read", parameters);
+    }
+    if (maxDepth) integrator.maxDepth = *maxDepth;
+}
+
+void SceneParser::parseForeignIntegrator(const Element& element, const std::string& prefix,
+                                         std::vector<std::string>& parameters, std::optional<int>& maxDepth) {
+    std::optional<int> nestedMaxDepth;
+    for (const Element& child : element.children()) {
+        const std::string tag = child.tag();
+        if (tag == "integrator") {  // adaptive, irrcache, multichannel wrap others
+            const std::string type = pluginType(child, kIntegratorTypes);
+            registerId(child);
+            parameters.push_back(prefix + "integrator '" + type + "'");
+            parseForeignIntegrator(child, prefix + type + ".", parameters, nestedMaxDepth);
+        } else if (xml::isValueTag(tag)) {
+            const std::string name = child.requireAttribute("name");
+            if (name != "maxDepth") {
+                parameters.push_back(prefix + name);
+                continue;
+            }
+            if (tag != "integer") child.fail("parameter 'maxDepth' must be given as <integer>, not <" + tag + ">");
+            if (maxDepth) child.fail("parameter 'maxDepth' is given twice");
+            child.checkAttributes({"name", "value"});
+            maxDepth = xml::parseInteger(child, child.requireAttribute("value"), "'maxDepth'");
+            checkMaxDepth(child, *maxDepth);
+        } else {
+            child.fail("unknown element <" + tag + "> in integrator; valid here: a value element (integer, float, " +
+                       "boolean, string, ...) or a nested <integrator>");
+        }
+    }
+    if (!maxDepth) maxDepth = nestedMaxDepth;  // the wrapped integrator's depth applies
 }
 
 void SceneParser::parseSensor(const Element& element) {
@@ -361,16 +361,31 @@ void SceneParser::parseSensor(const Element& element) {
         sensor.nearClip = *nearClip;
     }
     if (const auto farClip = params.getFloat("farClip")) sensor.farClip = *farClip;
+    context_.reportIgnoredParameters(
+        params, element, type, "a pinhole camera with an instantaneous shutter: no depth of field or motion blur");
     if (sensor.nearClip >= sensor.farClip)
         element.fail(fmt::format("nearClip ({}) must be smaller than farClip ({})", sensor.nearClip, sensor.farClip));
 }
-
 void SceneParser::parseFilm(const Element& element, SensorDescription& sensor) {
     const std::string type = pluginType(element, kFilmTypes);
     registerId(element);
     const PluginParams params(element, pluginName(element, type), kFilmParameters, {"rfilter"});
-    for (const Element& child : params.objects())
-        spdlog::warn("{}: ignoring the reconstruction filter (not configurable here)", child.where().describe());
+    const std::string outputReason =
+        "the result is a linear-RGB high-dynamic-range image; output settings have no "
+        "effect";
+    if (type == "ldrfilm") context_.reportIgnored(element, type, outputReason);
+    context_.reportIgnoredParameters(params, element, type, outputReason);
+    if (params.objects().size() > 1) params.objects()[1].fail("a film has only one <rfilter>");
+    for (const Element& child : params.objects()) {
+        const std::string filter = pluginType(child, kRfilterTypes);
+        registerId(child);
+        const PluginParams filterParams(child, pluginName(child, filter), kRfilterParameters, {});
+        const auto parameters = filterParams.ignoredParameters();
+        if (filter != "box" || !parameters.empty())  // Mitsuba's default box filter is what happens here
+            context_.reportIgnored(child, filter,
+                                   "reconstruction filter: pixels are box-filtered (each averages its own samples)",
+                                   parameters);
+    }
     for (const char* name : {"width", "height"}) {
         const auto value = params.getInteger(name);
         if (!value) continue;
@@ -387,39 +402,14 @@ void SceneParser::parseSampler(const Element& element, SensorDescription& sensor
     const std::string type = pluginType(element, kSamplerTypes);
     registerId(element);
     const PluginParams params(element, pluginName(element, type), kSamplerParameters, {});
+    const std::string reason = "camera samples are independent random numbers (sampleCount is used)";
+    if (type != "independent") context_.reportIgnored(element, type, reason);
+    context_.reportIgnoredParameters(params, element, type, reason);
     if (const auto count = params.getInteger("sampleCount")) {
         if (*count < 1 || *count > kMaxSampleCount)
             params.fail("sampleCount", fmt::format("sampleCount must be in [1, {}], got {}", kMaxSampleCount, *count));
         sensor.sampleCount = *count;
     }
-}
-
-BsdfDescription SceneParser::parseBsdf(const Element& element) {
-    const std::string type = pluginType(element, kBsdfTypes);
-    BsdfDescription bsdf;
-    if (type == "diffuse") {
-        const PluginParams params(element, pluginName(element, type), kDiffuseParameters, {"texture"});
-        if (!params.objects().empty()) params.objects().front().fail("textures are not supported yet");
-        bsdf.kind = BsdfDescription::Kind::Diffuse;
-        bsdf.reflectance = nonNegativeColor(params, "reflectance", bsdf.reflectance);
-        if (maxComponent(bsdf.reflectance) > 1.0f)
-            spdlog::warn("{}: reflectance {} exceeds 1 (not energy conserving)", element.where().describe(),
-                         formatRgb(bsdf.reflectance));
-    } else if (type == "null") {
-        const PluginParams params(element, pluginName(element, type), {}, {});
-        bsdf.kind = BsdfDescription::Kind::Null;
-    } else {  // twosided
-        const PluginParams params(element, pluginName(element, type), {}, {"bsdf", "ref"});
-        const auto& nested = params.objects();
-        if (nested.empty()) element.fail("twosided needs one nested <bsdf> or <ref>");
-        if (nested.size() > 1) nested[1].fail("twosided with different front and back bsdfs is not supported yet");
-        bsdf = nested[0].tag() == "bsdf" ? parseBsdf(nested[0]) : referencedBsdf(nested[0]);
-        if (bsdf.kind == BsdfDescription::Kind::Null)
-            nested[0].fail("twosided needs a reflecting bsdf such as diffuse, not null");
-        bsdf.twoSided = true;
-    }
-    registerId(element, bsdf);
-    return bsdf;
 }
 
 int SceneParser::parseMedium(const Element& element) {
@@ -467,10 +457,9 @@ int SceneParser::parseMedium(const Element& element) {
 
     scene_.media.push_back(medium);
     const int index = static_cast<int>(scene_.media.size()) - 1;
-    registerId(element, std::nullopt, index);
+    registerId(element, NamedObject::ofMedium(index));
     return index;
 }
-
 PhaseDescription SceneParser::parsePhase(const Element& element) {
     const std::string type = pluginType(element, kPhaseTypes);
     registerId(element);
@@ -485,32 +474,39 @@ PhaseDescription SceneParser::parsePhase(const Element& element) {
     if (!(phase.g > -1.0f && phase.g < 1.0f)) params.fail("g", fmt::format("g must be in (-1, 1), got {}", phase.g));
     return phase;
 }
-
 void SceneParser::parseShape(const Element& element) {
     const std::string type = pluginType(element, kShapeTypes);
     registerId(element);
-    const std::span<const ParamSpec> specs = type == "obj"      ? std::span<const ParamSpec>(kObjParameters)
-                                             : type == "sphere" ? std::span<const ParamSpec>(kSphereParameters)
-                                                                : std::span<const ParamSpec>(kBasicShapeParameters);
-    const PluginParams params(element, pluginName(element, type), specs, {"bsdf", "ref", "emitter", "medium"});
+    const std::span<const ParamSpec> specs = type == "obj"          ? std::span<const ParamSpec>(kObjParameters)
+                                             : type == "serialized" ? std::span<const ParamSpec>(kSerializedParameters)
+                                             : type == "sphere"     ? std::span<const ParamSpec>(kSphereParameters)
+                                                                    : std::span<const ParamSpec>(kBasicShapeParameters);
+    const std::string plugin = pluginName(element, type);
+    const PluginParams params(element, plugin, specs, {"bsdf", "ref", "emitter", "medium"});
     ShapeDescription shape;
     shape.where = element.where();
-    constexpr ShapeDescription::Kind kinds[] = {ShapeDescription::Kind::Obj, ShapeDescription::Kind::Rectangle,
+    constexpr ShapeDescription::Kind kinds[] = {ShapeDescription::Kind::Obj,  ShapeDescription::Kind::Rectangle,
                                                 ShapeDescription::Kind::Cube, ShapeDescription::Kind::Sphere,
-                                                ShapeDescription::Kind::Disk};
+                                                ShapeDescription::Kind::Disk, ShapeDescription::Kind::Serialized};
     shape.kind = kinds[std::find(std::begin(kShapeTypes), std::end(kShapeTypes), type) - std::begin(kShapeTypes)];
     if (const auto toWorld = params.getTransform("toWorld")) shape.toWorld = *toWorld;
     shape.flipNormals = params.getBoolean("flipNormals").value_or(false);
 
     if (type == "obj") {
-        const auto filename = params.getString("filename");
-        if (!filename) element.fail("missing parameter 'filename' (the .obj file)");
-        shape.filename = element.resolvePath(*filename);
-        checkReference(element, shape.filename);
-        std::error_code error;
-        if (!std::filesystem::is_regular_file(shape.filename, error))
-            params.fail("filename", "cannot find the OBJ file '" + shape.filename.string() + "'");
+        shape.filename = context_.requireFile(params, element, "filename", "OBJ file");
         shape.faceNormals = params.getBoolean("faceNormals").value_or(false);
+        context_.reportIgnoredParameters(params, element, type, "no effect in this renderer");
+    } else if (type == "serialized") {
+        shape.filename = context_.requireFile(params, element, "filename", "serialized mesh file");
+        shape.shapeIndex = params.getInteger("shapeIndex").value_or(0);
+        if (shape.shapeIndex < 0)
+            params.fail("shapeIndex", fmt::format("shapeIndex must be at least 0, got {}", shape.shapeIndex));
+        shape.faceNormals = params.getBoolean("faceNormals").value_or(false);
+        if (shape.faceNormals && params.has("maxSmoothAngle"))
+            params.fail("maxSmoothAngle", "give either 'faceNormals' or 'maxSmoothAngle', not both");
+        if (params.has("maxSmoothAngle"))
+            context_.reportIgnored(element, type, "normals are used as stored in the file, not re-smoothed by angle",
+                                   params.ignoredParameters(), /*warn=*/true);
     } else if (type == "sphere") {
         shape.center = params.getPoint("center").value_or(Vec3(0.0f));
         shape.radius = params.getFloat("radius").value_or(1.0f);
@@ -525,11 +521,12 @@ void SceneParser::parseShape(const Element& element) {
     const auto setBsdf = [&](const Element& child, const BsdfDescription& bsdf) {
         if (shape.bsdf) child.fail("a shape has only one bsdf");
         shape.bsdf = bsdf;
+        context_.useBsdf(bsdf);
     };
     for (const Element& child : params.objects()) {
         const std::string tag = child.tag();
         if (tag == "bsdf") {
-            setBsdf(child, parseBsdf(child));
+            setBsdf(child, mitsuba::parseBsdf(context_, child));
         } else if (tag == "emitter") {
             if (shape.areaRadiance) child.fail("a shape has only one emitter");
             shape.areaRadiance = parseAreaEmitter(child);
@@ -543,10 +540,10 @@ void SceneParser::parseShape(const Element& element) {
             if (name == "interior" || name == "exterior") {
                 setMedium(child, name, referencedMedium(child));
             } else if (name.empty() || name == "bsdf") {
-                const Named& named = lookup(child);
+                const NamedObject& named = context_.lookup(child);
                 if (named.tag == "medium")
                     child.fail("a medium reference inside a <shape> needs name=\"interior\" or name=\"exterior\"");
-                setBsdf(child, referencedBsdf(child));
+                setBsdf(child, context_.referencedBsdf(child));
             } else {
                 child.fail("unknown reference name '" + name + "'; valid names: interior, exterior, bsdf");
             }
@@ -560,6 +557,7 @@ Rgb SceneParser::parseAreaEmitter(const Element& element) {
         pluginType(element, kShapeEmitterTypes, " (point and spot emitters go at the top level, outside shapes)");
     registerId(element);
     const PluginParams params(element, pluginName(element, type), kAreaParameters, {});
+    context_.reportIgnoredParameters(params, element, type, kSamplingWeightReason);
     return nonNegativeColor(params, "radiance", Rgb(1.0f));
 }
 
@@ -571,6 +569,7 @@ EmitterDescription SceneParser::parseEmitter(const Element& element) {
         element, pluginName(element, type),
         spot ? std::span<const ParamSpec>(kSpotParameters) : std::span<const ParamSpec>(kPointParameters),
         {"medium", "ref"});
+    context_.reportIgnoredParameters(params, element, type, kSamplingWeightReason);
     EmitterDescription emitter;
     emitter.where = element.where();
     emitter.intensity = nonNegativeColor(params, "intensity", emitter.intensity);
@@ -602,43 +601,8 @@ int SceneParser::mediumChild(const Element& child, int current) {
     return referencedMedium(child);
 }
 
-// ---------------------------------------------------------------- ids and references
-
-void SceneParser::registerId(const Element& element, std::optional<BsdfDescription> bsdf, int medium) {
-    const auto id = element.attribute("id");
-    if (!id) return;
-    if (id->empty()) element.fail("an id must not be empty");
-    const auto previous = ids_.find(*id);
-    if (previous != ids_.end())
-        element.fail("duplicate id '" + *id + "' (first used at " + previous->second.where.describe() + ")");
-    ids_.emplace(*id, Named{element.tag(), std::move(bsdf), medium, element.where()});
-}
-
-const SceneParser::Named& SceneParser::lookup(const Element& ref) {
-    ref.checkAttributes({"id", "name"});
-    const std::string id = ref.requireAttribute("id");
-    const auto it = ids_.find(id);
-    if (it == ids_.end()) {
-        std::vector<std::string> known;
-        for (const auto& [name, named] : ids_)
-            if (named.tag == "bsdf" || named.tag == "medium") known.push_back(name + " (" + named.tag + ")");
-        ref.fail("unknown id '" + id + "'; " +
-                 (known.empty() ? std::string("no bsdf or medium ids are declared before this point")
-                                : "known ids: " + xml::joinNames(std::span<const std::string>(known))));
-    }
-    return it->second;
-}
-
-BsdfDescription SceneParser::referencedBsdf(const Element& ref) {
-    const Named& named = lookup(ref);
-    if (!named.bsdf)
-        ref.fail("id '" + ref.requireAttribute("id") + "' names a <" + named.tag + "> (" + named.where.describe() +
-                 "), not a <bsdf>");
-    return *named.bsdf;
-}
-
 int SceneParser::referencedMedium(const Element& ref) {
-    const Named& named = lookup(ref);
+    const NamedObject& named = context_.lookup(ref);
     if (named.medium < 0)
         ref.fail("id '" + ref.requireAttribute("id") + "' names a <" + named.tag + "> (" + named.where.describe() +
                  "), not a <medium>");

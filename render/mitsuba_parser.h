@@ -1,26 +1,42 @@
 // Mitsuba 0.5/0.6 XML scene parser: reads a scene file into a validated
 // SceneDescription (stage 1 of parse -> description -> render scene). Meshes
-// are not loaded here; an OBJ file is only checked to exist.
+// and images are not loaded here; OBJ, serialized and bitmap files are only
+// checked to exist.
 //
 // Supported subset (everything else is a SceneError that names the file, the
 // 1-based line and the element, and where useful lists the valid names):
 //   <scene version="0.x.y">, <default name value>, $name in any attribute,
-//   <include filename>, id/<ref id> (global ids, refs only to bsdf/medium);
-//   values float, integer, boolean, string, rgb ("r, g, b" | "v" | "#rrggbb"),
-//   spectrum (one uniform value), point/vector, transform (translate, rotate,
-//   scale, matrix, lookat; each applied after the previous ones);
-//   integrator volpath | volpath_simple | path | direct | vrl | vrlcuts | vpl;
-//   sensor perspective with film hdrfilm|ldrfilm and any Mitsuba sampler;
-//   shapes obj, rectangle, cube, sphere, disk; bsdfs diffuse, null, twosided;
+//   <include filename>, id/<ref id> (ids are global wherever they are nested;
+//   refs name bsdfs, media and textures declared earlier);
+//   values float, integer, boolean, string, rgb ("r, g, b" | "r g b" | "v" |
+//   "#rrggbb"), spectrum, point/vector, transform (translate, rotate, scale,
+//   matrix, lookat/lookAt; each applied after the previous ones);
+//   integrators volpath | volpath_simple | path | direct | vrl | vrlcuts, and
+//   every other Mitsuba 0.5/0.6 integrator (bdpt, sppm, ...) accepted with
+//   only maxDepth read: the rendering method comes from --method;
+//   sensor perspective with film hdrfilm | ldrfilm, any rfilter, any Mitsuba
+//   sampler (all sample independently);
+//   shapes obj, serialized (filename, shapeIndex), rectangle, cube, sphere, disk;
+//   bsdfs diffuse, dielectric, roughdielectric, conductor, roughconductor,
+//   plastic, roughplastic, ward, twosided, bumpmap (approximated: the bump
+//   map is ignored), null, with Mitsuba's defaults and named IORs and
+//   conductor presets (render/mitsuba_bsdf_parser.h, render/ior_table.h);
+//   textures bitmap and scale, nested in a bsdf or top-level with an id;
 //   emitters area (on shapes), point, spot; medium homogeneous with phase
 //   isotropic | hg.
-// Parameters that Mitsuba accepts but that change nothing here (e.g. film
-// pixelFormat, integrator rrDepth) are accepted with a spdlog warning.
+// What Mitsuba accepts but changes nothing here (rfilters, samplers' patterns,
+// film output settings, other integrators' options, bitmap filtering, ...) is
+// accepted, listed once per plugin kind in SceneDescription::ignored and
+// logged once; approximations in use are in SceneDescription::approximations.
 //
 // Mitsuba semantics worth knowing: a perspective sensor with neither fov nor
 // focalLength gets Mitsuba's 50mm focal length (46.79 degrees along the
 // diagonal); a medium with no coefficients gets sigmaS = sigmaA = 1 (Mitsuba's
-// own default, the "Skin1" preset, is not supported); hg's g defaults to 0.8.
+// own default, the "Skin1" preset, is not supported); hg's g defaults to 0.8;
+// a <ref> to an id nested in a wrapper (e.g. a bsdf inside a bumpmap) gets
+// that nested object, without the wrapper. SceneDescription::textures holds
+// only textures some colour parameter uses, each distinct file + mapping once
+// (a bump map's texture is checked but not stored).
 #pragma once
 
 #include <filesystem>

@@ -1,5 +1,6 @@
 #include "render/path_tracer.h"
 
+#include "render/camera_segment.h"
 #include "render/sampling.h"
 
 #include <algorithm>
@@ -25,19 +26,20 @@ DirectLighting sampleDirectLighting(const Scene& scene, const Vec3& point, const
     return {light.direction, light.weight * tr / probability};
 }
 
-namespace {
-
-}  // namespace
-
 Rgb VolumetricPathTracer::radiance(Ray ray, int medium, Rng& rng, const PathStart& start) const {
     Rgb result(0.0f), throughput(1.0f);
     int vertices = start.vertices;  // scattering vertices so far (null crossings do not count)
-    bool firstSegment = true;  // until the first scattering vertex
+    // Until the first vertex that is not a crossing (or, with start.throughSpecular, not a
+    // purely specular bounce): the stretch crossed with exact transmittance only.
+    bool firstSegment = true;
     const int maxDepth = settings_.maxDepth;
     const auto mayScatterAgain = [&] { return maxDepth < 0 || vertices < maxDepth; };
     // Restriction to medium-medium prefixes: contributions count from the second vertex on.
     const bool restricted = settings_.onlyMediumToMedium;
     const auto counts = [&] { return !restricted || vertices >= 2; };
+    // An emitter hit at the end of the current segment is counted: NEE could not have found it
+    // (the camera ray itself, or the bounce before was a Dirac lobe).
+    bool emissionCounts = start.emissionOnFirstHit && !restricted;
 
     float segmentStart = ray.tMin;  // where the ray entered its current medium
     int mediumBeforeCrossing = medium;  // before the last null boundary crossed
@@ -54,6 +56,7 @@ Rgb VolumetricPathTracer::radiance(Ray ray, int medium, Rng& rng, const PathStar
             if (flight.scattered) {
                 ++vertices;
                 firstSegment = false;
+                emissionCounts = false;
                 if (!mayScatterAgain()) break;
                 const Vec3 x = ray.at(segmentStart + flight.t);
                 const DirectLighting direct = sampleDirectLighting(scene_, x, nullptr, medium, rng);
@@ -74,41 +77,40 @@ Rgb VolumetricPathTracer::radiance(Ray ray, int medium, Rng& rng, const PathStar
         if (!hit || isBlack(throughput)) break;
 
         const SceneShape& shape = scene_.shapes()[hit->shape];
-        // Emission: only for paths NEE has not already accounted for.
-        if (start.emissionOnFirstHit && vertices == start.vertices && !restricted && shape.emitter >= 0)
+        if (emissionCounts && shape.emitter >= 0)
             result += throughput * scene_.emitters()[shape.emitter]->emittedRadiance(hit->geometricNormal, -ray.direction);
 
-        if (shape.bsdf.isNull()) {
+        const Bsdf& bsdf = shape.bsdf;
+        if (bsdf.isNull()) {
             if (!Scene::withinCrossing(ray, *hit)) mediumBeforeCrossing = medium;
             medium = scene_.mediumAfter(*hit, ray.direction, medium);
             segmentStart = hit->t;
             Scene::continuePast(ray, *hit);  // same ray: distances stay exact
             continue;
         }
-        firstSegment = false;
+        const bool specularChain =
+            firstSegment && start.throughSpecular && bsdf.isPurelySpecular() && vertices < kMaxSpecularChain;
+        if (!specularChain) firstSegment = false;
         if (Scene::withinCrossing(ray, *hit)) medium = mediumBeforeCrossing;
         if (restricted && vertices + 1 <= 2) break;  // a surface among the first two vertices
 
-        // Diffuse reflection on the side the ray arrived from.
-        Vec3 n = hit->shadingNormal;
-        const bool front = ray.direction.dot(hit->geometricNormal) < 0.0f;
-        if (!front) {
-            if (!shape.bsdf.twoSided) break;  // one-sided diffuse is black from behind
-            n = -n;
-        }
         ++vertices;
         if (!mayScatterAgain()) break;
-        const Rgb albedo = shape.bsdf.reflectance;
-        const DirectLighting direct = sampleDirectLighting(scene_, hit->position, &*hit, medium, rng);
-        const float ng = direct.direction.dot(hit->geometricNormal) * (front ? 1.0f : -1.0f);
-        if (counts() && !isBlack(direct.radianceOverPdf) && ng > 0.0f)
-            result += throughput * direct.radianceOverPdf * albedo * (std::max(0.0f, direct.direction.dot(n)) * kInvPi);
-
-        const Vec3 dir = Frame::fromNormal(n).toWorld(cosineHemisphere(Vec2(rng.next(), rng.next()))).normalized();
-        if (dir.dot(hit->geometricNormal) * (front ? 1.0f : -1.0f) <= 0.0f) break;  // below the true surface
-        throughput *= albedo;
-        medium = scene_.mediumAfter(*hit, dir, medium);
-        ray = Ray{Scene::offsetOrigin(*hit, dir), dir};
+        const ShadingPoint sp = hit->shadingPoint();
+        const Vec3 wo = -ray.direction;
+        if (!bsdf.isPurelySpecular()) {
+            const DirectLighting direct = sampleDirectLighting(scene_, hit->position, &*hit, medium, rng);
+            if (counts() && !isBlack(direct.radianceOverPdf)) {
+                const Rgb f = bsdf.eval(sp, wo, direct.direction, TransportMode::Radiance);
+                if (!isBlack(f)) result += throughput * direct.radianceOverPdf * f;
+            }
+        }
+        const auto sampled = bsdf.sample(sp, wo, Vec2(rng.next(), rng.next()), rng.next(), TransportMode::Radiance);
+        if (!sampled || isBlack(sampled->weight)) break;
+        throughput *= sampled->weight;
+        emissionCounts = sampled->delta && (!restricted || vertices >= 2);
+        medium = scene_.mediumAfter(*hit, sampled->wi, medium);
+        ray = Ray{Scene::offsetOrigin(*hit, sampled->wi), sampled->wi};
         segmentStart = 0.0f;
         if (vertices >= settings_.rouletteDepth) {
             const float q = std::min(maxComponent(throughput), 0.95f);

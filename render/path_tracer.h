@@ -1,8 +1,9 @@
 // VolumetricPathTracer: the reference estimator. Unidirectional path tracing
-// through homogeneous media (free-flight sampling with spectral MIS) and diffuse
-// surfaces, with next-event estimation at every medium and surface vertex, and
-// emission counted only where NEE cannot reach it (camera rays and rays that
-// only crossed null boundaries). Unbiased for every light in the scene subset.
+// through homogeneous media (free-flight sampling with spectral MIS) and the
+// surface models of bsdf.h, with next-event estimation at every medium vertex and
+// every surface vertex with a non-Dirac lobe, and emission counted only where NEE
+// cannot reach it (camera rays, rays that only crossed null boundaries, and rays
+// leaving a sampled Dirac lobe). Unbiased for every light in the scene subset.
 //
 // Path length follows Mitsuba's maxDepth: a path of k scattering vertices has
 // k+1 segments; 1 = directly visible emitters, 2 = + direct lighting and single
@@ -29,6 +30,9 @@ struct PathStart {
     // transmittance, sampling no medium collision on it.
     bool firstSegmentTransmittanceOnly = false;
     bool emissionOnFirstHit = true;  // count an emitter hit at the end of that segment
+    // The first segment continues through purely specular bounces (glass, mirrors):
+    // the camera path of the VRL decomposition (camera_segment.h).
+    bool throughSpecular = false;
 };
 
 class VolumetricPathTracer {

@@ -5,9 +5,11 @@
 #include <Imath/ImathBox.h>
 #include <embree3/rtcore.h>
 #include <spdlog/spdlog.h>
+#include <tbb/parallel_for.h>
 
 #include <algorithm>
 #include <cmath>
+#include <span>
 #include <stdexcept>
 #include <string>
 
@@ -51,16 +53,19 @@ void embreeErrorCallback(void* userData, RTCError code, const char* message) {
     if (embree->empty()) embree->assign(message ? message : "unknown Embree error");
 }
 
-Bsdf makeBsdf(const ShapeDescription& shape) {
-    Bsdf bsdf;
+Bsdf makeBsdf(const ShapeDescription& shape, std::span<const std::shared_ptr<const Texture>> textures) {
     if (shape.bsdf) {
-        bsdf.kind = shape.bsdf->kind == BsdfDescription::Kind::Null ? Bsdf::Kind::Null : Bsdf::Kind::Diffuse;
-        bsdf.reflectance = shape.bsdf->reflectance;
-        bsdf.twoSided = shape.bsdf->twoSided;
-    } else if ((shape.interiorMedium >= 0 || shape.exteriorMedium >= 0) && !shape.areaRadiance) {
-        bsdf.kind = Bsdf::Kind::Null;  // Mitsuba: a bare shape between media is an invisible boundary
+        for (const auto& c : {shape.bsdf->reflectance, shape.bsdf->specularReflectance, shape.bsdf->specularTransmittance})
+            if (c.texture >= int(textures.size())) throw SceneError(shape.where, "texture index out of range");
+        try {
+            return Bsdf(*shape.bsdf, textures);
+        } catch (const std::invalid_argument& e) {
+            throw SceneError(shape.where, e.what());
+        }
     }
-    return bsdf;
+    // Mitsuba: a bare shape between media is an invisible boundary.
+    if ((shape.interiorMedium >= 0 || shape.exteriorMedium >= 0) && !shape.areaRadiance) return Bsdf::null();
+    return Bsdf();
 }
 
 PhaseFunction makePhase(const PhaseDescription& phase) {
@@ -110,17 +115,23 @@ std::unique_ptr<Scene> Scene::build(const SceneDescription& description) {
             throw SceneError(where, "medium index " + std::to_string(index) + " out of range");
     };
     checkMedium(description.sensor.medium, description.sensor.where);
+    scene->textures_.resize(description.textures.size());
+    tbb::parallel_for(size_t(0), description.textures.size(), [&](size_t i) {
+        scene->textures_[i] = Texture::load(description.textures[i]);
+    });
+    for (const auto& note : description.approximations) spdlog::warn("approximation: {}", note);
     scene->shapes_.reserve(description.shapes.size());
     for (const auto& s : description.shapes) {
         checkMedium(s.interiorMedium, s.where);
         checkMedium(s.exteriorMedium, s.where);
         SceneShape shape;
         shape.mesh = buildShapeMesh(s);
-        shape.bsdf = makeBsdf(s);
+        shape.bsdf = makeBsdf(s, scene->textures_);
         shape.interiorMedium = s.interiorMedium;
         shape.exteriorMedium = s.exteriorMedium;
         shape.changesMedium = s.interiorMedium >= 0 || s.exteriorMedium >= 0;
         scene->hasNullSurfaces_ = scene->hasNullSurfaces_ || shape.bsdf.isNull();
+        scene->hasSpecularSurfaces_ = scene->hasSpecularSurfaces_ || shape.bsdf.isPurelySpecular();
         scene->shapes_.push_back(std::move(shape));
     }
     // Area emitters reference their mesh: create them only once shapes_ is final.
@@ -269,6 +280,7 @@ std::optional<SurfaceHit> Scene::intersect(const Ray& ray) const {
     hit.position = mesh.positions[tri[0]] * (1 - u - v) + mesh.positions[tri[1]] * u + mesh.positions[tri[2]] * v;
     hit.geometricNormal = mesh.geometricNormal(hit.triangle);
     hit.shadingNormal = mesh.shadingNormal(hit.triangle, u, v);
+    hit.uv = mesh.texcoord(hit.triangle, u, v);
     if (hit.shadingNormal.dot(hit.geometricNormal) < 0.0f) hit.shadingNormal = -hit.shadingNormal;
     return hit;
 }

@@ -8,6 +8,7 @@
 #include "render/camera.h"
 #include "render/emitter.h"
 #include "render/homogeneous_medium.h"
+#include "render/texture.h"
 #include "render/scene_description.h"
 #include "render/triangle_mesh.h"
 
@@ -31,8 +32,11 @@ struct SurfaceHit {
     Vec3 position;
     Vec3 geometricNormal;  // unit, the mesh's front (outside / emitting) side
     Vec3 shadingNormal;    // unit, interpolated, on the same side as geometricNormal
+    Vec2 uv{0.0f, 0.0f};   // texture coordinates (barycentrics for meshes without uvs)
     uint32_t shape = 0;
     uint32_t triangle = 0;
+
+    ShadingPoint shadingPoint() const { return {geometricNormal, shadingNormal, uv}; }
 };
 
 class Scene {
@@ -57,6 +61,10 @@ public:
     // its boundary is convex and nothing else lies inside it (no occlusion rays needed).
     bool mediumNeedsVisibility(int medium) const { return medium < 0 || mediumNeedsVisibility_[medium]; }
     bool hasNullSurfaces() const { return hasNullSurfaces_; }
+    // Some surface has a purely specular BSDF (glass, mirror): camera paths continue through it.
+    bool hasSpecularSurfaces() const { return hasSpecularSurfaces_; }
+    // The loaded textures, in SceneDescription::textures order.
+    const std::vector<std::shared_ptr<const Texture>>& textures() const { return textures_; }
 
     // Closest surface along the ray within (0, ray.tMax).
     std::optional<SurfaceHit> intersect(const Ray& ray) const;
@@ -96,6 +104,8 @@ private:
     std::vector<std::unique_ptr<Emitter>> emitters_;
     std::unique_ptr<EmitterSampler> emitterSampler_;
     bool hasNullSurfaces_ = false;
+    bool hasSpecularSurfaces_ = false;
+    std::vector<std::shared_ptr<const Texture>> textures_;
     std::vector<bool> mediumNeedsVisibility_;
     struct Embree;
     std::unique_ptr<Embree> embree_;

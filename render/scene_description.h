@@ -11,6 +11,7 @@
 #include "render/transform.h"
 
 #include <filesystem>
+#include <map>
 #include <optional>
 #include <string>
 #include <vector>
@@ -32,23 +33,74 @@ struct MediumDescription {
     SourceLocation where;
 };
 
-// bsdf type="diffuse" | "null", optionally wrapped in "twosided".
+// texture type="bitmap": an image file mapped with the shape's uv coordinates.
+struct TextureDescription {
+    std::filesystem::path filename;  // resolved, absolute or relative to the cwd
+    float uscale = 1.0f, vscale = 1.0f, uoffset = 0.0f, voffset = 0.0f;
+    enum class Wrap { Repeat, Mirror, Clamp, Zero, One };
+    Wrap wrapU = Wrap::Repeat, wrapV = Wrap::Repeat;
+    // Display gamma of the stored values; absent: Mitsuba's rule (sRGB for 8/16-bit
+    // integer images, linear for float images). -1 means the sRGB curve.
+    std::optional<float> gamma;
+    SourceLocation where;
+};
+
+// A colour parameter: a constant, or a texture (index into SceneDescription::textures)
+// scaled by `value` (1 unless the scene wraps the texture in a scale).
+struct ColorDescription {
+    Rgb value{0.5f};
+    int texture = -1;
+};
+
+// Microfacet distribution of the rough models (Mitsuba's `distribution`).
+enum class MicrofacetKind { Beckmann, GGX, Phong };
+
+// A surface model of the scene subset (Mitsuba 0.5 plugins and defaults):
+//   diffuse        reflectance
+//   null           invisible boundary between two media
+//   dielectric     smooth glass: intIOR/extIOR, specularReflectance/Transmittance
+//   roughdielectric  + distribution, alphaU/alphaV
+//   conductor      smooth metal: eta/k (complex IOR relative to extEta), specularReflectance
+//   roughconductor + distribution, alphaU/alphaV
+//   plastic        smooth dielectric coating over a diffuse base: intIOR/extIOR,
+//                  diffuseReflectance, specularReflectance, nonlinear
+//   roughplastic   + distribution, alpha (isotropic)
+//   ward           Ward's anisotropic glossy model (variant), diffuseReflectance,
+//                  specularReflectance, alphaU/alphaV
+// twosided wraps any of them (the same model on both sides); bumpmap wraps one and
+// is approximated by it (listed in `approximations`).
 struct BsdfDescription {
-    enum class Kind { Diffuse, Null };
+    enum class Kind { Diffuse, Null, Dielectric, RoughDielectric, Conductor, RoughConductor, Plastic, RoughPlastic, Ward };
     Kind kind = Kind::Diffuse;
-    Rgb reflectance{0.5f};
+    ColorDescription reflectance{Rgb(0.5f)};            // diffuse; plastic and ward: diffuseReflectance
+    ColorDescription specularReflectance{Rgb(1.0f)};    // dielectric, conductor, plastic; ward (default 0.2)
+    ColorDescription specularTransmittance{Rgb(1.0f)};  // dielectric
+    float intIOR = 1.5046f;    // dielectric/plastic interior index (Mitsuba: bk7; plastic: polypropylene 1.49)
+    float extIOR = 1.000277f;  // exterior index (air)
+    Rgb eta{0.200438f, 0.924033f, 1.10221f};  // conductor, relative to extEta (Mitsuba default: Cu)
+    Rgb k{3.91295f, 2.45285f, 2.14219f};
+    float extEta = 1.000277f;
+    MicrofacetKind distribution = MicrofacetKind::Beckmann;
+    float alphaU = 0.1f, alphaV = 0.1f;  // roughness; `alpha` sets both
+    bool nonlinear = false;              // plastic: account for internal scattering (Mitsuba's flag)
+    enum class WardVariant { Ward, WardDuer, Balanced };
+    WardVariant wardVariant = WardVariant::Balanced;
     bool twoSided = false;
+    // Human-readable notes on what this model approximates (e.g. "bumpmap: the bump
+    // map is ignored"); the loader reports them once and writes them into the EXR.
+    std::vector<std::string> approximations;
 };
 
 struct ShapeDescription {
-    enum class Kind { Obj, Rectangle, Cube, Sphere, Disk };
+    enum class Kind { Obj, Rectangle, Cube, Sphere, Disk, Serialized };
     Kind kind = Kind::Rectangle;
-    std::filesystem::path filename;  // obj: resolved, absolute or relative to the cwd
+    std::filesystem::path filename;  // obj/serialized: resolved, absolute or relative to the cwd
+    int shapeIndex = 0;              // serialized: which mesh of the file
     Transform toWorld;
     Vec3 center{0.0f};    // sphere
     float radius = 1.0f;  // sphere
     bool flipNormals = false;
-    bool faceNormals = false;  // obj: ignore vertex normals
+    bool faceNormals = false;  // obj/serialized: ignore vertex normals
     // Absent: Mitsuba's default (diffuse 0.5, or null if the shape separates media).
     std::optional<BsdfDescription> bsdf;
     std::optional<Rgb> areaRadiance;  // emitter type="area" attached to the shape
@@ -104,6 +156,24 @@ struct SceneDescription {
     std::vector<MediumDescription> media;
     std::vector<ShapeDescription> shapes;
     std::vector<EmitterDescription> emitters;
+    std::vector<TextureDescription> textures;
+    // Plugins and parameters read but without effect here (filters, samplers'
+    // patterns, unknown integrators' options), one line each, for the log and metadata.
+    std::vector<std::string> ignored;
+    // Approximations in use (bump maps ignored, ...), one line each; also in EXR metadata.
+    std::vector<std::string> approximations;
 };
+
+// The scene's approximations and ignored plugins as EXR metadata ("vrl.approximations",
+// "vrl.ignored": entries joined by "; "), so an image says what it does not model.
+inline void addSceneNotes(const SceneDescription& scene, std::map<std::string, std::string>& metadata) {
+    const auto join = [](const std::vector<std::string>& lines) {
+        std::string out;
+        for (const auto& line : lines) out += (out.empty() ? "" : "; ") + line;
+        return out;
+    };
+    if (!scene.approximations.empty()) metadata["vrl.approximations"] = join(scene.approximations);
+    if (!scene.ignored.empty()) metadata["vrl.ignored"] = join(scene.ignored);
+}
 
 }  // namespace vrl

@@ -16,6 +16,7 @@ struct TriangleMesh {
     std::vector<Vec3> positions;                 // world space
     std::vector<Vec3> normals;                   // per vertex, unit; empty = flat shading
     std::vector<std::array<uint32_t, 3>> triangles;
+    std::vector<Vec2> texcoords;  // per vertex uv; empty = none (uv = barycentrics)
 
     float triangleArea(size_t i) const {
         const auto& t = triangles[i];
@@ -31,6 +32,12 @@ struct TriangleMesh {
         if (normals.empty()) return geometricNormal(i);
         const auto& t = triangles[i];
         return (normals[t[0]] * (1 - u - v) + normals[t[1]] * u + normals[t[2]] * v).normalized();
+    }
+    // Interpolated uv at barycentrics (u, v); meshes without texcoords give (u, v).
+    Vec2 texcoord(size_t i, float u, float v) const {
+        if (texcoords.empty()) return {u, v};
+        const auto& t = triangles[i];
+        return texcoords[t[0]] * (1 - u - v) + texcoords[t[1]] * u + texcoords[t[2]] * v;
     }
 };
 

@@ -172,7 +172,7 @@ Rgb VrlEstimator::sampleOnce(const Vrl& vrl, const CameraSegment& segment, Rng& 
     const float w = std::sqrt(w2);
     const Vec3 toU = d / w;
     const float phase = mediumV.phase().eval(vrl.direction, toU) * mediumU.phase().eval(toU, -segment.direction);
-    const Rgb cameraTransmittance = segment.transmittanceBefore * mediumU.transmittance(float(u));
+    const Rgb cameraTransmittance = segment.throughputBefore * mediumU.transmittance(float(u));
     const Rgb between = vrl.medium == segment.medium && !scene_.mediumNeedsVisibility(segment.medium)
                             ? mediumU.transmittance(w)
                             : scene_.transmittance(xu, xv, segment.medium);

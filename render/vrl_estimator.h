@@ -40,7 +40,7 @@ public:
     VrlEstimator(const Scene& scene, int samplesPerVrl);
 
     // One estimate of the VRL's radiance contribution to the segment's origin end
-    // (already multiplied by the segment's transmittanceBefore).
+    // (already multiplied by the segment's throughputBefore).
     Rgb contribution(const Vrl& vrl, const CameraSegment& segment, Rng& rng) const;
 
 private:

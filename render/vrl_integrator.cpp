@@ -1,5 +1,7 @@
 #include "render/vrl_integrator.h"
 
+#include <spdlog/spdlog.h>
+
 #include <cmath>
 
 namespace vrl {
@@ -13,17 +15,20 @@ VrlIntegrator::VrlIntegrator(const Scene& scene, const VrlSet& vrls, const VrlIn
       estimator_(scene, settings.vrlSamples),
       tree_(tree) {
     if (tree_) lightcuts_ = std::make_unique<LightcutsEstimator>(scene, *tree_, estimator_, settings.cut);
+    if (settings.maxDepth >= 0 && scene.hasSpecularSurfaces() && settings.transports.has(TransportPart::Multiple))
+        spdlog::warn("maxDepth {} with specular surfaces: multiple scattering (d) seen through glass or mirrors "
+                     "does not count the specular bounces towards maxDepth", settings.maxDepth);
 }
 
 std::array<Rgb, 4> VrlIntegrator::samplePathParts(const Ray& cameraRay, Rng& rng) const {
     std::array<Rgb, 4> parts{Rgb(0.0f), Rgb(0.0f), Rgb(0.0f), Rgb(0.0f)};
     if (settings_.transports.has(TransportPart::Surface))
         parts[size_t(TransportPart::Surface)] =
-            tracer_.radiance(cameraRay, scene_.cameraMedium(), rng, PathStart{0, true, true});
+            tracer_.radiance(cameraRay, scene_.cameraMedium(), rng, PathStart{0, true, true, true});
     const bool single = settings_.transports.has(TransportPart::Single);
     const bool mediumSurface = settings_.transports.has(TransportPart::MediumSurface);
     if (!single && !mediumSurface) return parts;
-    for (const CameraSegment& segment : cameraSegments(scene_, cameraRay, scene_.cameraMedium())) {
+    for (const CameraSegment& segment : cameraSegments(scene_, cameraRay, scene_.cameraMedium(), &rng, settings_.maxDepth)) {
         if (scene_.media()[segment.medium].isNonScattering()) continue;
         if (single) parts[size_t(TransportPart::Single)] += singleScattering(segment, rng);
         if (mediumSurface) parts[size_t(TransportPart::MediumSurface)] += mediumToSurface(segment, rng);
@@ -32,7 +37,7 @@ std::array<Rgb, 4> VrlIntegrator::samplePathParts(const Ray& cameraRay, Rng& rng
 }
 
 Rgb VrlIntegrator::singleScattering(const CameraSegment& segment, Rng& rng) const {
-    if (settings_.maxDepth >= 0 && settings_.maxDepth < 2) return Rgb(0.0f);
+    if (settings_.maxDepth >= 0 && settings_.maxDepth < segment.specularBefore + 2) return Rgb(0.0f);
     const EmitterSampler& sampler = scene_.emitterSampler();
     if (sampler.empty()) return Rgb(0.0f);
     const auto [index, probability] = sampler.sample(rng.next());
@@ -48,12 +53,12 @@ Rgb VrlIntegrator::singleScattering(const CameraSegment& segment, Rng& rng) cons
     if (isBlack(toLight)) return Rgb(0.0f);
     const HomogeneousMedium& medium = scene_.media()[segment.medium];
     const float phase = medium.phase().eval(-light.direction, -segment.direction);
-    return segment.transmittanceBefore * medium.transmittance(us.t) * medium.sigmaS() * light.weight * toLight *
+    return segment.throughputBefore * medium.transmittance(us.t) * medium.sigmaS() * light.weight * toLight *
            (phase / (probability * us.pdf));
 }
 
 Rgb VrlIntegrator::mediumToSurface(const CameraSegment& segment, Rng& rng) const {
-    if (settings_.maxDepth >= 0 && settings_.maxDepth < 3) return Rgb(0.0f);
+    if (settings_.maxDepth >= 0 && settings_.maxDepth < segment.specularBefore + 3) return Rgb(0.0f);
     const HomogeneousMedium& medium = scene_.media()[segment.medium];
     // u on [0, length] from one channel's truncated exponential, chosen uniformly;
     // the pdf is the average over channels (spectral MIS), so no channel's
@@ -75,8 +80,8 @@ Rgb VrlIntegrator::mediumToSurface(const CameraSegment& segment, Rng& rng) const
     const PhaseSample next = medium.phase().sample(segment.direction, Vec2(rng.next(), rng.next()));
     // Exact transmittance to the next surface, reflected light only: a path that
     // scatters again in the medium first belongs to (d), emission at the surface to (b).
-    const Rgb reflected = tracer_.radiance(Ray{x, next.direction}, segment.medium, rng, PathStart{1, true, false});
-    return segment.transmittanceBefore * medium.transmittance(float(u)) * medium.sigmaS() * reflected *
+    const Rgb reflected = tracer_.radiance(Ray{x, next.direction}, segment.medium, rng, PathStart{1 + segment.specularBefore, true, false});
+    return segment.throughputBefore * medium.transmittance(float(u)) * medium.sigmaS() * reflected *
            float(1.0 / pdf);
 }
 
@@ -88,7 +93,7 @@ Rgb VrlIntegrator::multipleScattering(const Ray& cameraRay, Rng& rng, CutStatist
     // and Lightcuts shading, so the two differ only by the cut's approximation.
     const uint64_t pixelKey = (uint64_t(rng.nextUint()) << 32) | rng.nextUint();
     uint64_t segmentIndex = 0;
-    for (const CameraSegment& segment : cameraSegments(scene_, cameraRay, scene_.cameraMedium())) {
+    for (const CameraSegment& segment : cameraSegments(scene_, cameraRay, scene_.cameraMedium(), &rng, settings_.maxDepth)) {
         const uint64_t streamKey = Rng::combine(pixelKey, segmentIndex++);
         if (scene_.media()[segment.medium].isNonScattering()) continue;
         if (lightcuts_) {

@@ -7,7 +7,11 @@
 // direction reaches (exact transmittance in between, no emission there: (b)
 // has it); (d) sums the VRL estimator over every VRL (plain VRLs, --method vrl).
 // Each part is estimated for paths its siblings leave out, so the parts add up
-// to the reference path tracer's image.
+// to the reference path tracer's image. Camera paths continue through purely
+// specular surfaces (camera_segment.h): parts (b)-(d) shade every medium
+// segment of that path, and (a) takes the first other surface it reaches.
+// With a finite maxDepth, the specular bounces count towards it in (a)-(c); part
+// (d) does not know each VRL's depth and ignores them (a warning says so).
 #pragma once
 
 #include "render/cut.h"

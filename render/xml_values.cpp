@@ -1,5 +1,7 @@
 #include "render/xml_values.h"
 
+#include "render/spectrum.h"
+
 #include <Imath/ImathMatrix.h>
 #include <spdlog/spdlog.h>
 
@@ -57,6 +59,7 @@ std::vector<std::string_view> tagsFor(ParamType type) {
         case ParamType::Boolean: return {"boolean"};
         case ParamType::String: return {"string"};
         case ParamType::Color: return {"rgb", "spectrum", "float"};
+        case ParamType::FloatOrName: return {"float", "string"};
         case ParamType::Point: return {"point", "vector"};
         case ParamType::Transform: return {"transform"};
     }
@@ -265,6 +268,8 @@ std::filesystem::path Element::resolvePath(const std::string& filename) const {
 
 // ---------------------------------------------------------------- values
 
+bool isValueTag(std::string_view tag) { return contains(kValueTags, tag); }
+
 std::string joinNames(std::span<const std::string_view> names) {
     std::string out;
     for (const std::string_view name : names) out += (out.empty() ? "" : ", ") + std::string(name);
@@ -331,8 +336,16 @@ Rgb parseColor(const Element& element) {
         if (element.has("filename")) element.fail("spectra from files are not supported yet; give an <rgb> instead");
         const std::string text = element.requireAttribute("value");
         const auto tokens = splitList(text);
-        if (text.find(':') != std::string::npos)
-            element.fail("wavelength:value spectra are not supported yet; give the colour as <rgb value=\"r, g, b\"/>");
+        if (text.find(':') != std::string::npos) {
+            // Sampled spectrum "λ:v, ...", converted as Mitsuba's RGB build does (render/spectrum.h).
+            if (element.has("intent"))
+                element.fail("'intent' applies to a single uniform value only, not to wavelength:value pairs");
+            try {
+                return spectrumToRgb(parseWavelengthSpectrum(text));
+            } catch (const std::invalid_argument& e) {
+                element.fail(std::string("invalid sampled spectrum: ") + e.what());
+            }
+        }
         if (tokens.size() != 1)
             element.fail(
                 "a <spectrum> must be a single uniform value here (discretised spectra are not supported yet), got " +
@@ -413,9 +426,6 @@ PluginParams::PluginParams(const Element& plugin, std::string pluginName, std::s
                            std::to_string(previous->element.where().line) + ")");
             if (spec->use == ParamUse::Unsupported)
                 child.fail("parameter " + inQuotes(name) + " of " + pluginName_ + " is not supported yet");
-            if (spec->use == ParamUse::Ignore)
-                spdlog::warn("{}: ignoring parameter '{}' of {} (it has no effect in this renderer)",
-                             child.where().describe(), name, pluginName_);
             params_.push_back({name, &*spec, child});
         } else if (std::find(objectTags.begin(), objectTags.end(), tag) != objectTags.end()) {
             objects_.push_back(child);
@@ -495,6 +505,22 @@ std::optional<Transform> PluginParams::getTransform(std::string_view name) const
     const Param* p = findTyped(name, ParamType::Transform);
     if (!p) return std::nullopt;
     return parseTransform(p->element);
+}
+
+std::optional<std::variant<float, std::string>> PluginParams::getFloatOrName(std::string_view name) const {
+    const Param* p = findTyped(name, ParamType::FloatOrName);
+    if (!p) return std::nullopt;
+    p->element.checkAttributes({"name", "value"});
+    const std::string value = p->element.requireAttribute("value");
+    if (p->element.tag() == "string") return value;
+    return parseFloat(p->element, value, inQuotes(name));
+}
+
+std::vector<std::string> PluginParams::ignoredParameters() const {
+    std::vector<std::string> names;
+    for (const Param& param : params_)
+        if (param.spec->use == ParamUse::Ignore) names.push_back(param.name);
+    return names;
 }
 
 const Element* PluginParams::element(std::string_view name) const {

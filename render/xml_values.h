@@ -17,6 +17,7 @@
 #include <span>
 #include <string>
 #include <string_view>
+#include <variant>
 #include <vector>
 
 #include "render/geometry.h"
@@ -94,6 +95,9 @@ private:
     const Defines* defines_;
 };
 
+// Whether `tag` is a value element (<float>, <rgb>, <transform>, ...).
+bool isValueTag(std::string_view tag);
+
 // "a, b, c" (for messages listing valid names).
 std::string joinNames(std::span<const std::string_view> names);
 std::string joinNames(std::span<const std::string> names);
@@ -122,12 +126,13 @@ enum class ParamType {
     Boolean,    // <boolean>
     String,     // <string>
     Color,      // <rgb>, <spectrum> or <float>
+    FloatOrName,  // <float>, or <string> naming a value (e.g. the index of refraction "water")
     Point,      // <point> or <vector>
     Transform,  // <transform>
 };
 enum class ParamUse {
     Read,         // the plugin uses it
-    Ignore,       // accepted, but has no effect here (warned about)
+    Ignore,       // accepted, but has no effect here (see PluginParams::ignoredParameters)
     Unsupported,  // valid in Mitsuba, not implemented here (an error)
 };
 struct ParamSpec {
@@ -156,6 +161,11 @@ public:
     std::optional<Rgb> getColor(std::string_view name) const;
     std::optional<Vec3> getPoint(std::string_view name) const;
     std::optional<Transform> getTransform(std::string_view name) const;
+    // A FloatOrName parameter: the number, or the name as written.
+    std::optional<std::variant<float, std::string>> getFloatOrName(std::string_view name) const;
+    // Names of the given parameters whose use is ParamUse::Ignore, in document
+    // order; the caller reports them (PluginParams itself logs nothing).
+    std::vector<std::string> ignoredParameters() const;
 
     // The element that gave parameter `name`, or nullptr.
     const Element* element(std::string_view name) const;

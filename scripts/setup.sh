@@ -7,6 +7,7 @@ packages=(
   build-essential cmake pkg-config git
   libembree-dev libopenexr-dev libimath-dev
   libtbb-dev libspdlog-dev libfmt-dev libcli11-dev libpugixml-dev libtinyobjloader-dev
+  libopenimageio-dev
   libgtest-dev libgmock-dev
   libgrpc++-dev libprotobuf-dev protobuf-compiler protobuf-compiler-grpc
   python3 python3-numpy python3-yaml openssl iproute2

@@ -59,6 +59,7 @@ struct Coordinator::Job {
     std::vector<TileRect> tiles;
     std::map<std::pair<int, int>, uint32_t> tileAt;  // (x0, y0) -> tile
     std::vector<std::string> layerNames;
+    std::map<std::string, std::string> sceneNotes;  // EXR metadata: approximations, ignored plugins
     v1::JobAssets assets;
     std::deque<uint32_t> pending;  // may hold tiles done since they were queued: skipped when popped
     std::vector<uint8_t> queued;   // tile is in `pending`
@@ -353,6 +354,8 @@ void Coordinator::prepare(Job& job) {
         auto t0 = Clock::now();
         rpc::JobScene scene = rpc::loadJobScene(directory, directory / bundle.scene_path(), job.spec, options_.limits);
         phases.emplace_back("load scene", secondsSince(t0));
+        std::map<std::string, std::string> sceneNotes;
+        addSceneNotes(scene.scene->description(), sceneNotes);
         RenderStatistics statistics;
         t0 = Clock::now();
         const RenderLights lights = prepareLights(*scene.scene, scene.settings, [&](const char*, double f) {
@@ -413,6 +416,7 @@ void Coordinator::prepare(Job& job) {
         job.tiles = tiles;
         for (uint32_t t = 0; t < tiles.size(); ++t) job.tileAt[{tiles[t].x0, tiles[t].y0}] = t;
         job.layerNames = layerNames;
+        job.sceneNotes = std::move(sceneNotes);
         job.done.assign(tiles.size(), 0);
         job.queued.assign(tiles.size(), 0);
         job.rejections.assign(tiles.size(), 0);
@@ -730,6 +734,8 @@ void Coordinator::finishJob(Job& job) {
     for (const auto& [name, value] : std::map<std::string, std::string>(job.spec.defines().begin(), job.spec.defines().end()))
         defines += (defines.empty() ? "" : " ") + name + "=" + value;
     images.metadata["vrl.defines"] = defines;
+    if (!job.spec.medium().empty()) images.metadata["vrl.medium"] = job.spec.medium();
+    images.metadata.insert(job.sceneNotes.begin(), job.sceneNotes.end());
     images.metadata["vrl.time.render"] = std::to_string(secondsSince(job.renderStart));
     for (const auto& [phase, seconds] : job.phases) images.metadata["vrl.time." + phase] = std::to_string(seconds);
     if (stats.vrlCount > 0) {

@@ -404,8 +404,8 @@ CameraSegment randomSegment(Rng& rng, const Region& region, const ReferenceLine&
     s.direction = unitF(direction);
     s.length = float(length);
     s.medium = medium;
-    for (int c = 0; c < 3; ++c) s.transmittanceBefore[c] = float(1.0 - rng.nextDouble());  // (0, 1]
-    if (rng.next() < 0.2f) s.transmittanceBefore = Rgb(1.0f);
+    for (int c = 0; c < 3; ++c) s.throughputBefore[c] = float(1.0 - rng.nextDouble());  // (0, 1]
+    if (rng.next() < 0.2f) s.throughputBefore = Rgb(1.0f);
     return s;
 }
 
@@ -820,7 +820,7 @@ TEST(ClusterBound, AnisotropyEpsilonScalesTheIsotropicBound) {
     segment.direction = Vec3(1.0f, 0.0f, 0.0f);
     segment.length = 20.0f;
     segment.medium = 0;
-    segment.transmittanceBefore = Rgb(0.9f, 0.5f, 0.7f);
+    segment.throughputBefore = Rgb(0.9f, 0.5f, 0.7f);
     for (float epsilon : {0.0f, 1.0f, 3.0f}) {
         ClusterBoundSettings settings;
         settings.anisotropyEpsilon = epsilon;

@@ -41,13 +41,14 @@ struct MeanEstimate {
 
 // The unit square [0,1]^2 at z = 0, facing +z, as two triangles.
 TriangleMesh unitSquare() {
-    return {{Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(1, 1, 0), Vec3(0, 1, 0)}, {}, {{0, 1, 2}, {0, 2, 3}}};
+    return {{Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(1, 1, 0), Vec3(0, 1, 0)}, {}, {{0, 1, 2}, {0, 2, 3}}, {}};
 }
 // [0,3]x[0,1] at z = 0, facing +z: a fan of triangles of areas 0.45, 1.05, 0.9, 0.6.
 TriangleMesh fanRectangle() {
     return {{Vec3(0, 0, 0), Vec3(3, 0, 0), Vec3(3, 0.3f, 0), Vec3(3, 1, 0), Vec3(1.2f, 1, 0), Vec3(0, 1, 0)},
             {},
-            {{0, 1, 2}, {0, 2, 3}, {0, 3, 4}, {0, 4, 5}}};
+            {{0, 1, 2}, {0, 2, 3}, {0, 3, 4}, {0, 4, 5}},
+            {}};
 }
 
 // Spot at (1, 2, 3) aimed at the origin.

@@ -28,7 +28,7 @@ ShapeDescription shape(Kind kind, const Transform& toWorld = {}) {
 
 ShapeDescription nullShape(Kind kind, int interior, int exterior, const Transform& toWorld = {}) {
     ShapeDescription s = shape(kind, toWorld);
-    s.bsdf = BsdfDescription{BsdfDescription::Kind::Null, Rgb(0.0f), false};
+    s.bsdf = test::nullBsdf();
     s.interiorMedium = interior;
     s.exteriorMedium = exterior;
     return s;
@@ -168,7 +168,7 @@ std::filesystem::path scratchObj(const std::string& name, const std::string& con
 bool convexityOfMediumInside(ShapeDescription boundary) {
     auto d = emptyScene();
     d.media.push_back(medium("fog", Rgb(1.0f), Rgb(0.1f)));
-    boundary.bsdf = BsdfDescription{BsdfDescription::Kind::Null, Rgb(0.0f), false};
+    boundary.bsdf = test::nullBsdf();
     boundary.interiorMedium = 0;
     d.shapes.push_back(boundary);
     return Scene::build(d)->media()[0].boundaryConvex();
@@ -276,20 +276,20 @@ TEST(SceneTest, DefaultBsdfFollowsMitsuba) {
     d.shapes.push_back(lamp);  // 3: area emitter between media -> diffuse
     ShapeDescription blue = shape(Kind::Cube);
     blue.interiorMedium = 0;
-    blue.bsdf = BsdfDescription{BsdfDescription::Kind::Diffuse, Rgb(0.1f, 0.2f, 0.9f), true};
+    blue.bsdf = test::diffuseBsdf(Rgb(0.1f, 0.2f, 0.9f), true);
     d.shapes.push_back(blue);  // 4: an explicit bsdf wins
     const auto scene = Scene::build(d);
     const auto& s = scene->shapes();
     EXPECT_TRUE(s[0].bsdf.isNull());
     EXPECT_TRUE(s[1].bsdf.isNull());
-    EXPECT_EQ(s[2].bsdf.kind, Bsdf::Kind::Diffuse);
-    EXPECT_EQ(s[2].bsdf.reflectance, Rgb(0.5f));
-    EXPECT_FALSE(s[2].bsdf.twoSided);
-    EXPECT_EQ(s[3].bsdf.kind, Bsdf::Kind::Diffuse);
+    EXPECT_EQ(s[2].bsdf.kind(), BsdfDescription::Kind::Diffuse);
+    EXPECT_EQ(s[2].bsdf.albedo(Vec2(0.5f)), Rgb(0.5f));
+    EXPECT_FALSE(s[2].bsdf.twoSided());
+    EXPECT_EQ(s[3].bsdf.kind(), BsdfDescription::Kind::Diffuse);
     EXPECT_EQ(s[3].emitter, 0);  // area emitters come before the point light
-    EXPECT_EQ(s[4].bsdf.kind, Bsdf::Kind::Diffuse);
-    EXPECT_EQ(s[4].bsdf.reflectance, Rgb(0.1f, 0.2f, 0.9f));
-    EXPECT_TRUE(s[4].bsdf.twoSided);
+    EXPECT_EQ(s[4].bsdf.kind(), BsdfDescription::Kind::Diffuse);
+    EXPECT_EQ(s[4].bsdf.albedo(Vec2(0.5f)), Rgb(0.1f, 0.2f, 0.9f));
+    EXPECT_TRUE(s[4].bsdf.twoSided());
     EXPECT_TRUE(scene->hasNullSurfaces());
 }
 
@@ -308,7 +308,7 @@ TEST(SceneTest, OpaqueWallFlushWithNullBoundaryStillBlocks) {
             d.media.push_back(m);
             ShapeDescription box;
             box.kind = ShapeDescription::Kind::Cube;
-            box.bsdf = BsdfDescription{BsdfDescription::Kind::Null, Rgb(0.0f), false};
+            box.bsdf = test::nullBsdf();
             box.interiorMedium = 0;
             ShapeDescription room;
             room.kind = ShapeDescription::Kind::Cube;

@@ -1,12 +1,18 @@
 // Tests of buildShapeMesh: the area of every tessellated shape against its
 // closed form (or the exact area of the inscribed polygon / polyhedron), the
 // outward orientation of triangles and vertex normals under flipNormals and
-// mirroring transforms, watertightness of closed shapes, and mesh-file errors.
+// mirroring transforms, watertightness of closed shapes, Mitsuba's texture
+// coordinates of the analytic shapes, OBJ quads, polygons, mixed face formats and
+// vt, .serialized shapes (written here with zlib), and mesh-file errors.
 #include "render/shape_mesh.h"
 
 #include <gtest/gtest.h>
+#include <zlib.h>
 
+#include <algorithm>
 #include <cmath>
+#include <cstdint>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <map>
@@ -291,6 +297,234 @@ TEST(ShapeMeshTest, MissingAndEmptyObjFilesAreSceneErrors) {
     expectSceneErrorNaming(s, "vertices-only.obj");
     s.filename = scratchFile("placeholder", "").parent_path();  // a directory, not a file
     expectSceneErrorNaming(s, "shape_mesh_test");
+}
+
+
+// --- Texture coordinates of the analytic shapes (Mitsuba's parameterisations) ---
+
+TEST(ShapeMeshTest, RectangleTexcoordsFollowMitsuba) {
+    const auto m = buildShapeMesh(shape(Kind::Rectangle));
+    ASSERT_EQ(m.texcoords.size(), m.positions.size());
+    for (size_t v = 0; v < m.positions.size(); ++v)
+        EXPECT_EQ(m.texcoords[v], Vec2((m.positions[v].x + 1) / 2, (m.positions[v].y + 1) / 2));
+    // uv belongs to the object-space corner, whatever toWorld does (here a mirror).
+    const auto mirrored = buildShapeMesh(shape(Kind::Rectangle, Transform::scale(Vec3(-2, 1, 1))));
+    for (size_t v = 0; v < mirrored.positions.size(); ++v)
+        EXPECT_EQ(mirrored.texcoords[v], Vec2((-mirrored.positions[v].x / 2 + 1) / 2, (mirrored.positions[v].y + 1) / 2));
+    // Interpolated inside a triangle: the centre of the square, halfway from corner 0 to
+    // corner 2 of triangle 0, maps to (0.5, 0.5).
+    EXPECT_EQ(m.texcoord(0, 0.0f, 0.5f), Vec2(0.5f, 0.5f));
+}
+
+TEST(ShapeMeshTest, CubeTexcoordsMapEveryFaceOntoTheUnitSquare) {
+    const auto m = buildShapeMesh(shape(Kind::Cube));
+    ASSERT_EQ(m.texcoords.size(), 24u);
+    for (size_t face = 0; face < 6; ++face) {
+        std::map<std::pair<float, float>, int> corners;
+        for (size_t k = 0; k < 4; ++k) ++corners[{m.texcoords[4 * face + k].x, m.texcoords[4 * face + k].y}];
+        EXPECT_EQ(corners.size(), 4u) << "face " << face;
+        for (const auto& [uv, count] : corners) {
+            EXPECT_TRUE(uv.first == 0 || uv.first == 1);
+            EXPECT_TRUE(uv.second == 0 || uv.second == 1);
+        }
+    }
+    // Mitsuba's +z face: (1,-1,1) -> (0,1), (1,1,1) -> (1,1), (-1,1,1) -> (1,0), (-1,-1,1) -> (0,0).
+    for (size_t v = 12; v < 16; ++v) {
+        ASSERT_EQ(m.positions[v].z, 1.0f);
+        EXPECT_EQ(m.texcoords[v], Vec2((m.positions[v].y + 1) / 2, (m.positions[v].x + 1) / 2)) << "vertex " << v;
+    }
+}
+
+TEST(ShapeMeshTest, SphereTexcoordsArePhiAndTheta) {
+    auto s = shape(Kind::Sphere);
+    s.center = Vec3(1, 2, 3);
+    s.radius = 2.0f;
+    const auto m = buildShapeMesh(s);
+    ASSERT_EQ(m.texcoords.size(), m.positions.size());
+    for (size_t v = 0; v < m.positions.size(); ++v) {
+        const Vec3 d = (m.positions[v] - s.center) / s.radius;
+        const Vec2 uv = m.texcoords[v];
+        EXPECT_NEAR(uv.y, std::acos(std::clamp(d.z, -1.0f, 1.0f)) / M_PI, 1e-5) << "vertex " << v;
+        if (std::hypot(d.x, d.y) < 1e-3f) continue;  // poles: phi undefined
+        float phi = std::atan2(d.y, d.x);
+        if (phi < 0) phi += 2 * float(M_PI);
+        const float u = phi / (2 * float(M_PI));
+        // The seam has vertices on both sides: u = 0 and u = 1.
+        EXPECT_LT(std::min(std::abs(uv.x - u), std::abs(std::abs(uv.x - u) - 1.0f)), 1e-5f) << "vertex " << v;
+    }
+    // No triangle spans the seam: u varies by at most one sector within a triangle.
+    for (size_t i = 0; i < m.triangles.size(); ++i) {
+        const auto& t = m.triangles[i];
+        float lo = 2, hi = -1;
+        for (uint32_t v : t) lo = std::min(lo, m.texcoords[v].x), hi = std::max(hi, m.texcoords[v].x);
+        ASSERT_LE(hi - lo, 1.0f / (2 * kCurvedShapeSegments) + 1e-6f) << "triangle " << i;
+    }
+}
+
+TEST(ShapeMeshTest, DiskTexcoordsAreRadiusAndAngle) {
+    const auto m = buildShapeMesh(shape(Kind::Disk));
+    ASSERT_EQ(m.texcoords.size(), m.positions.size());
+    for (size_t v = 0; v < m.positions.size(); ++v) {
+        const Vec3& p = m.positions[v];
+        const float r = std::hypot(p.x, p.y);
+        EXPECT_NEAR(m.texcoords[v].x, r, 1e-6f);
+        if (r < 0.5f) continue;
+        float phi = std::atan2(p.y, p.x);
+        if (phi < -1e-6f) phi += 2 * float(M_PI);
+        const float v01 = m.texcoords[v].y;
+        EXPECT_TRUE(std::abs(v01 - phi / (2 * float(M_PI))) < 1e-5f || (v01 == 1.0f && std::abs(phi) < 1e-5f))
+            << "vertex " << v;
+    }
+    for (const auto& t : m.triangles) EXPECT_LE(std::abs(m.texcoords[t[2]].y - m.texcoords[t[1]].y), 0.011f);
+}
+
+// --- OBJ faces: quads, polygons, mixed formats, vt ---
+
+double areaTowards(const TriangleMesh& m, const Vec3& direction) {
+    double area = 0.0;
+    for (size_t i = 0; i < m.triangles.size(); ++i) area += m.triangleArea(i) * m.geometricNormal(i).dot(direction);
+    return area;
+}
+
+ShapeDescription objShape(const std::string& name, const std::string& contents) {
+    auto s = shape(Kind::Obj);
+    s.filename = scratchFile(name, contents);
+    return s;
+}
+
+TEST(ShapeMeshTest, ObjQuadsAndPolygonsAreTriangulated) {
+    // A 2 x 1 quad and an L-shaped (concave) hexagon of area 3, both facing +z.
+    const auto m = buildShapeMesh(objShape("polygons.obj",
+                                           "v 0 0 0\nv 2 0 0\nv 2 1 0\nv 0 1 0\n"
+                                           "v 0 0 1\nv 2 0 1\nv 2 1 1\nv 1 1 1\nv 1 2 1\nv 0 2 1\n"
+                                           "f 1 2 3 4\nf 5 6 7 8 9 10\n"));
+    ASSERT_EQ(m.triangles.size(), 2u + 4u);
+    EXPECT_NEAR(totalArea(m), 2.0 + 3.0, 1e-6);
+    EXPECT_NEAR(areaTowards(m, Vec3(0, 0, 1)), 5.0, 1e-6);  // every triangle faces +z
+    EXPECT_TRUE(m.texcoords.empty());
+    EXPECT_TRUE(m.normals.empty());
+}
+
+TEST(ShapeMeshTest, ObjMixedFaceFormatsAndTexcoords) {
+    const auto m = buildShapeMesh(objShape("mixed.obj",
+                                           "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\n"
+                                           "vt 0 0\nvt 0.5 0\nvt 0.5 0.5\nvt 0 0.5\n"
+                                           "vn 0 0 1\n"
+                                           "f 1 2 3\n"            // v
+                                           "f 1/1 3/3 4/4\n"      // v/vt
+                                           "f 1//1 2//1 3//1\n"   // v//vn
+                                           "f 1/1/1 2/2/1 3/3/1 4/4/1\n"));  // v/vt/vn quad
+    ASSERT_EQ(m.triangles.size(), 5u);
+    EXPECT_NEAR(areaTowards(m, Vec3(0, 0, 1)), 2.5, 1e-6);
+    ASSERT_EQ(m.texcoords.size(), m.positions.size());
+    for (size_t v = 0; v < m.positions.size(); ++v) {
+        const bool fromVt = v >= 3 && !(v >= 6 && v < 9);  // the plain and v//vn faces have none
+        const Vec2 expected = fromVt ? Vec2(m.positions[v].x / 2, m.positions[v].y / 2) : Vec2(0.0f);
+        EXPECT_EQ(m.texcoords[v], expected) << "corner " << v;
+    }
+    // Faces without vn leave zero normals, so the whole mesh is shaded flat.
+    EXPECT_TRUE(m.normals.empty());
+    // Only v//vn and v/vt/vn faces: smooth normals are kept.
+    const auto smooth = buildShapeMesh(objShape("normals.obj",
+                                                "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nvt 0 0\nvn 0 0 1\n"
+                                                "f 1//1 2//1 3//1\nf 1/1/1 3/1/1 4/1/1\n"));
+    ASSERT_EQ(smooth.normals.size(), smooth.positions.size());
+    EXPECT_EQ(smooth.normals[4], Vec3(0, 0, 1));
+}
+
+TEST(ShapeMeshTest, ObjBadIndicesAreSceneErrors) {
+    auto s = objShape("bad-vt.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nf 1/1 2/5 3/1\n");
+    s.where = {"room.xml", 12, "<shape type=\"obj\">"};
+    expectSceneErrorNaming(s, "bad-vt.obj");
+    s.filename = scratchFile("bad-quad.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3 9\n");
+    expectSceneErrorNaming(s, "bad-quad.obj");
+}
+
+// --- .serialized shapes ---
+
+void putBytes(std::string& out, const void* data, size_t size) { out.append(static_cast<const char*>(data), size); }
+
+// A version-4 .serialized file (little-endian host) holding each mesh in `meshes`: float
+// positions, normals when given, texcoords when given, uint32 triangles.
+std::filesystem::path serializedFile(const std::string& name, const std::vector<TriangleMesh>& meshes) {
+    std::string file;
+    std::vector<uint64_t> offsets;
+    for (const TriangleMesh& m : meshes) {
+        std::string raw;
+        const uint32_t flags = 0x1000 | (m.normals.empty() ? 0 : 0x1) | (m.texcoords.empty() ? 0 : 0x2);
+        const uint64_t counts[2] = {m.positions.size(), m.triangles.size()};
+        putBytes(raw, &flags, 4);
+        raw.append("mesh", 5);
+        putBytes(raw, counts, 16);
+        putBytes(raw, m.positions.data(), 12 * m.positions.size());
+        putBytes(raw, m.normals.data(), 12 * m.normals.size());
+        putBytes(raw, m.texcoords.data(), 8 * m.texcoords.size());
+        putBytes(raw, m.triangles.data(), 12 * m.triangles.size());
+        uLongf size = compressBound(uLong(raw.size()));
+        std::string z(size, '\0');
+        EXPECT_EQ(compress(reinterpret_cast<Bytef*>(z.data()), &size, reinterpret_cast<const Bytef*>(raw.data()),
+                           uLong(raw.size())),
+                  Z_OK);
+        offsets.push_back(file.size());
+        const uint16_t header[2] = {0x041C, 4};
+        putBytes(file, header, 4);
+        file.append(z.data(), size);
+    }
+    putBytes(file, offsets.data(), 8 * offsets.size());
+    const uint32_t count = uint32_t(meshes.size());
+    putBytes(file, &count, 4);
+    return scratchFile(name, file);
+}
+
+TEST(ShapeMeshTest, SerializedShapesAreTransformedToWorld) {
+    TriangleMesh quad;
+    quad.positions = {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}};
+    quad.normals = {{0, 0, 1}, {0, 0, 1}, {0, 0, 1}, {0, 0, 1}};
+    quad.texcoords = {{0, 0}, {1, 0}, {1, 1}, {0, 1}};
+    quad.triangles = {{0, 1, 2}, {0, 2, 3}};
+    TriangleMesh triangle;
+    triangle.positions = {{0, 0, 0}, {0, 1, 0}, {0, 0, 1}};
+    triangle.triangles = {{0, 1, 2}};
+    auto s = shape(Kind::Serialized);
+    s.filename = serializedFile("two.serialized", {triangle, quad});
+    s.shapeIndex = 1;
+    // z' = x + 2z tilts the quad's plane; normals follow the inverse transpose.
+    s.toWorld = Transform::fromRowMajor({1, 0, 0, 0, 0, 1, 0, 0, 1, 0, 2, 0, 0, 0, 0, 1})
+                    .then(Transform::translate(Vec3(5, 0, 0)));
+    const auto m = buildShapeMesh(s);
+    ASSERT_EQ(m.triangles.size(), 2u);
+    EXPECT_EQ(m.positions[2], Vec3(6, 1, 1));
+    EXPECT_EQ(m.texcoords, quad.texcoords);
+    ASSERT_EQ(m.normals.size(), 4u);
+    const Vec3 tilted = Vec3(-1, 0, 1).normalized();
+    EXPECT_LT((m.normals[0] - tilted).length(), 1e-6f);
+    EXPECT_LT((m.geometricNormal(0) - tilted).length(), 1e-6f);
+    // faceNormals drops the file's normals; shape 0 has none to begin with.
+    s.faceNormals = true;
+    EXPECT_TRUE(buildShapeMesh(s).normals.empty());
+    s.shapeIndex = 0;
+    s.faceNormals = false;
+    const auto first = buildShapeMesh(s);
+    EXPECT_EQ(first.triangles.size(), 1u);
+    EXPECT_TRUE(first.normals.empty());
+    EXPECT_TRUE(first.texcoords.empty());
+    EXPECT_NEAR(totalArea(first), 1.0, 1e-6);  // x = 0 on it, so only z *= 2 acts
+}
+
+TEST(ShapeMeshTest, SerializedErrorsAreSceneErrors) {
+    TriangleMesh triangle;
+    triangle.positions = {{0, 0, 0}, {0, 1, 0}, {0, 0, 1}};
+    triangle.triangles = {{0, 1, 2}};
+    auto s = shape(Kind::Serialized);
+    s.where = {"room.xml", 12, "<shape type=\"serialized\">"};
+    s.filename = serializedFile("one.serialized", {triangle});
+    s.shapeIndex = 3;
+    expectSceneErrorNaming(s, "holds 1 shape");
+    s.filename = std::filesystem::path(testing::TempDir()) / "no-such-mesh.serialized";
+    s.shapeIndex = 0;
+    expectSceneErrorNaming(s, "no-such-mesh.serialized");
+    s.filename = scratchFile("not-serialized.serialized", "this is not a mesh at all");
+    expectSceneErrorNaming(s, "format id");
 }
 
 }  // namespace

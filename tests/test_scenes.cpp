@@ -32,7 +32,7 @@ SceneDescription emittingSphereFurnace(const Rgb& radiance, const Rgb& sigmaS, f
     sphere.kind = ShapeDescription::Kind::Sphere;
     sphere.radius = 1.0f;
     sphere.flipNormals = true;  // emit towards the centre
-    sphere.bsdf = BsdfDescription{BsdfDescription::Kind::Diffuse, Rgb(0.0f), false};
+    sphere.bsdf = test::diffuseBsdf(Rgb(0.0f), false);
     sphere.areaRadiance = radiance;
     sphere.exteriorMedium = 0;  // flipped: the inside is the exterior side
     scene.shapes.push_back(sphere);
@@ -46,7 +46,7 @@ SceneDescription absorberSlab(const Rgb& radiance, const Rgb& sigmaA, float thic
     ShapeDescription slab;
     slab.kind = ShapeDescription::Kind::Cube;
     slab.toWorld = Transform::scale(Vec3(10.0f, 10.0f, 0.5f * thickness)).then(Transform::translate(Vec3(0, 0, 3)));
-    slab.bsdf = BsdfDescription{BsdfDescription::Kind::Null, Rgb(0.0f), false};
+    slab.bsdf = test::nullBsdf();
     slab.interiorMedium = 0;
     scene.shapes.push_back(slab);
     ShapeDescription light;
@@ -80,7 +80,7 @@ SceneDescription mediumOnlyCube(const Rgb& sigmaS, const Rgb& sigmaA, float g) {
     scene.media.push_back(medium("cube", sigmaS, sigmaA, g));
     ShapeDescription cube;
     cube.kind = ShapeDescription::Kind::Cube;
-    cube.bsdf = BsdfDescription{BsdfDescription::Kind::Null, Rgb(0.0f), false};
+    cube.bsdf = test::nullBsdf();
     cube.interiorMedium = 0;
     scene.shapes.push_back(cube);
     EmitterDescription light;
@@ -101,20 +101,20 @@ SceneDescription litRoomWithOccluder(const Rgb& sigmaS, const Rgb& sigmaA, float
     ShapeDescription room;
     room.kind = ShapeDescription::Kind::Cube;
     room.toWorld = Transform::scale(Vec3(2.0f));
-    room.bsdf = BsdfDescription{BsdfDescription::Kind::Diffuse, Rgb(0.6f, 0.55f, 0.5f), true};
+    room.bsdf = test::diffuseBsdf(Rgb(0.6f, 0.55f, 0.5f), true);
     scene.shapes.push_back(room);
     ShapeDescription occluder;
     occluder.kind = ShapeDescription::Kind::Cube;
     occluder.toWorld = Transform::scale(Vec3(0.5f, 0.8f, 0.5f)).then(Transform::rotate(Vec3(0, 1, 0), 25.0f)).then(
         Transform::translate(Vec3(0.4f, -1.2f, 0.6f)));
-    occluder.bsdf = BsdfDescription{BsdfDescription::Kind::Diffuse, Rgb(0.3f, 0.5f, 0.7f), false};
+    occluder.bsdf = test::diffuseBsdf(Rgb(0.3f, 0.5f, 0.7f), false);
     scene.shapes.push_back(occluder);
     ShapeDescription panel;
     panel.kind = ShapeDescription::Kind::Rectangle;
     panel.toWorld = Transform::scale(Vec3(0.4f)).then(Transform::rotate(Vec3(1, 0, 0), 90.0f)).then(
         Transform::translate(Vec3(-0.8f, 1.95f, 0.8f)));  // +z rotated to -y: faces the floor
     panel.areaRadiance = Rgb(6.0f, 5.0f, 4.0f);
-    panel.bsdf = BsdfDescription{BsdfDescription::Kind::Diffuse, Rgb(0.0f), false};
+    panel.bsdf = test::diffuseBsdf(Rgb(0.0f), false);
     scene.shapes.push_back(panel);
     EmitterDescription spot;
     spot.kind = EmitterDescription::Kind::Spot;
@@ -123,6 +123,28 @@ SceneDescription litRoomWithOccluder(const Rgb& sigmaS, const Rgb& sigmaA, float
     spot.beamWidth = 25.0f;
     spot.toWorld = Transform::lookAt(Vec3(1.2f, 1.6f, -0.5f), Vec3(0.2f, -2.0f, 0.8f), Vec3(0, 0, 1));
     scene.emitters.push_back(spot);
+    return scene;
+}
+
+SceneDescription glassAndMirrorRoom(const Rgb& sigmaS, const Rgb& sigmaA, float g) {
+    SceneDescription scene = litRoomWithOccluder(sigmaS, sigmaA, g);
+    ShapeDescription glass;
+    glass.kind = ShapeDescription::Kind::Sphere;
+    glass.center = Vec3(-0.1f, -0.6f, 0.3f);
+    glass.radius = 0.55f;
+    glass.bsdf = BsdfDescription{};
+    glass.bsdf->kind = BsdfDescription::Kind::Dielectric;
+    glass.bsdf->intIOR = 1.5f;
+    glass.bsdf->extIOR = 1.0f;
+    glass.exteriorMedium = 0;  // vacuum inside
+    scene.shapes.push_back(glass);
+    ShapeDescription mirror;
+    mirror.kind = ShapeDescription::Kind::Rectangle;
+    mirror.toWorld = Transform::scale(Vec3(0.9f)).then(Transform::rotate(Vec3(0, 1, 0), -90.0f)).then(
+        Transform::translate(Vec3(1.95f, -0.2f, 0.9f)));  // +z rotated to -x: faces into the room
+    mirror.bsdf = BsdfDescription{};
+    mirror.bsdf->kind = BsdfDescription::Kind::Conductor;  // Mitsuba's default: copper
+    scene.shapes.push_back(mirror);
     return scene;
 }
 
@@ -135,13 +157,13 @@ SceneDescription smallSmokeRoom() {
     ShapeDescription room;
     room.kind = ShapeDescription::Kind::Cube;
     room.toWorld = Transform::scale(Vec3(2.0f));
-    room.bsdf = BsdfDescription{BsdfDescription::Kind::Diffuse, Rgb(0.6f, 0.5f, 0.4f), true};
+    room.bsdf = test::diffuseBsdf(Rgb(0.6f, 0.5f, 0.4f), true);
     scene.shapes.push_back(room);
     ShapeDescription ball;
     ball.kind = ShapeDescription::Kind::Sphere;
     ball.center = Vec3(0.5f, -1.4f, 0.8f);
     ball.radius = 0.6f;
-    ball.bsdf = BsdfDescription{BsdfDescription::Kind::Diffuse, Rgb(0.2f, 0.6f, 0.3f), false};
+    ball.bsdf = test::diffuseBsdf(Rgb(0.2f, 0.6f, 0.3f), false);
     scene.shapes.push_back(ball);
     EmitterDescription spot;
     spot.kind = EmitterDescription::Kind::Spot;

@@ -6,6 +6,20 @@
 
 namespace vrl::test {
 
+// Diffuse (Lambertian) and null surface models for scenes built in code.
+inline BsdfDescription diffuseBsdf(const Rgb& reflectance, bool twoSided) {
+    BsdfDescription bsdf;
+    bsdf.kind = BsdfDescription::Kind::Diffuse;
+    bsdf.reflectance.value = reflectance;
+    bsdf.twoSided = twoSided;
+    return bsdf;
+}
+inline BsdfDescription nullBsdf() {
+    BsdfDescription bsdf;
+    bsdf.kind = BsdfDescription::Kind::Null;
+    return bsdf;
+}
+
 // A camera at the origin looking down +z with the given film and fov.
 SensorDescription cameraAtOrigin(int width, int height, float fovDegrees);
 
@@ -32,6 +46,11 @@ SceneDescription mediumOnlyCube(const Rgb& sigmaS, const Rgb& sigmaA, float g);
 // an opaque diffuse occluder box inside, a spot light and an area light (a
 // rectangle under the ceiling facing down). Flat geometry only.
 SceneDescription litRoomWithOccluder(const Rgb& sigmaS, const Rgb& sigmaA, float g);
+
+// litRoomWithOccluder with a solid glass sphere (vacuum inside, the medium
+// outside) in front of the occluder and a copper mirror on the right wall:
+// camera paths reach the medium through glass and in the mirror.
+SceneDescription glassAndMirrorRoom(const Rgb& sigmaS, const Rgb& sigmaA, float g);
 
 // A closed room (cube of half-size 2) with two-sided diffuse walls, a diffuse
 // sphere, a spot light and a scene-filling medium: a little of everything.

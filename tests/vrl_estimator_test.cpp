@@ -101,7 +101,7 @@ V3d quadrature(const Vrl& vrl, const CameraSegment& seg, const MediumParams& m, 
         integral = gaussLegendre([&](double alpha) { return thetaIntegral(v0 + h0 * std::sinh(alpha) / sinT) / sinT; },
                                  std::asinh(-sinT * v0 / h0), std::asinh(sinT * (t - v0) / h0), panels);
     }
-    return integral * toD(seg.transmittanceBefore) * toD(vrl.flux) * m.sigmaS * m.sigmaS;
+    return integral * toD(seg.throughputBefore) * toD(vrl.flux) * m.sigmaS * m.sigmaS;
 }
 
 // Quadrature at 16 and 32 panels (128 and 256 nodes per variable); the change
@@ -186,7 +186,7 @@ Vec3 uniformSphere(Rng& rng) {
 }
 
 // Random pairs (seed (11, 0)): origins in [-1, 1]^3, VRL length in [0.2, 1.5],
-// camera length in [0.5, 3], transmittanceBefore in [0.3, 1].
+// camera length in [0.5, 3], throughputBefore in [0.3, 1].
 std::vector<Pair> randomPairs(int count, const Rgb& flux) {
     Rng rng(11, 0);
     const auto inCube = [&] { return Vec3(2 * rng.next() - 1, 2 * rng.next() - 1, 2 * rng.next() - 1); };

@@ -133,6 +133,16 @@ TEST(VrlImage, PartsSumToReferenceInMediumOnlyScene) {
     }
 }
 
+// Camera paths continue through glass and a mirror (camera_segment.h); light
+// paths refract into volumetric caustics. Grey medium only, to keep the time down.
+TEST(VrlImage, PartsSumToReferenceThroughGlassAndMirror) {
+    const MediumCase& m = kMedia[0];
+    const auto scene = Scene::build(test::glassAndMirrorRoom(m.sigmaS * 0.5f, m.sigmaA * 0.5f, m.g));
+    ASSERT_TRUE(scene->hasSpecularSurfaces());
+    expectAgree(vrlRuns(*scene, "surface,single,medium-surface,multiple", 16, kVrls),
+                referenceRuns(*scene, kReferenceSpp, false), "glass and mirror");
+}
+
 TEST(VrlImage, PartsSumToReferenceInLitRoomWithOccluder) {
     for (const MediumCase& m : kMedia) {
         const auto scene = Scene::build(test::litRoomWithOccluder(m.sigmaS * 0.5f, m.sigmaA * 0.5f, m.g));
