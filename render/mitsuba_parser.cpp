@@ -78,7 +78,7 @@ constexpr ParamSpec kSphereParameters[] = {
     {"toWorld", T::Transform}, {"flipNormals", T::Boolean}, {"center", T::Point}, {"radius", T::Float}};
 constexpr ParamSpec kObjParameters[] = {
     {"filename", T::String}, {"toWorld", T::Transform}, {"flipNormals", T::Boolean}, {"faceNormals", T::Boolean},
-    {"flipTexCoords", T::Boolean, U::Ignore}, {"maxSmoothAngle", T::Float, U::Unsupported}};
+    {"flipTexCoords", T::Boolean}, {"maxSmoothAngle", T::Float, U::Unsupported}};
 constexpr ParamSpec kSerializedParameters[] = {
     {"filename", T::String}, {"shapeIndex", T::Integer}, {"toWorld", T::Transform}, {"flipNormals", T::Boolean},
     {"faceNormals", T::Boolean}, {"maxSmoothAngle", T::Float, U::Ignore}};
@@ -495,6 +495,7 @@ void SceneParser::parseShape(const Element& element) {
     if (type == "obj") {
         shape.filename = context_.requireFile(params, element, "filename", "OBJ file");
         shape.faceNormals = params.getBoolean("faceNormals").value_or(false);
+        shape.flipTexCoords = params.getBoolean("flipTexCoords").value_or(true);
         context_.reportIgnoredParameters(params, element, type, "no effect in this renderer");
     } else if (type == "serialized") {
         shape.filename = context_.requireFile(params, element, "filename", "serialized mesh file");

@@ -101,6 +101,7 @@ struct ShapeDescription {
     float radius = 1.0f;  // sphere
     bool flipNormals = false;
     bool faceNormals = false;  // obj/serialized: ignore vertex normals
+    bool flipTexCoords = true;  // obj: Mitsuba's default, OBJ's v = 0 is the image's bottom row
     // Absent: Mitsuba's default (diffuse 0.5, or null if the shape separates media).
     std::optional<BsdfDescription> bsdf;
     std::optional<Rgb> areaRadiance;  // emitter type="area" attached to the shape

@@ -178,6 +178,11 @@ TriangleMesh buildShapeMesh(const ShapeDescription& shape) {
         case ShapeDescription::Kind::Obj: m = loadObj(shape); break;
         case ShapeDescription::Kind::Serialized: m = loadSerialized(shape); break;
     }
+    // Mitsuba's uv put v = 0 at the image's top row; Texture's at the bottom row (OBJ's
+    // convention, which Mitsuba's default flipTexCoords undoes).
+    if (shape.kind != ShapeDescription::Kind::Obj || !shape.flipTexCoords) {
+        for (auto& uv : m.texcoords) uv.y = 1.0f - uv.y;
+    }
     const bool mirrored = shape.toWorld.flipsHandedness();
     for (auto& p : m.positions) p = shape.toWorld.applyPoint(p);
     for (auto& n : m.normals) {

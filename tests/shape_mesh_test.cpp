@@ -301,16 +301,17 @@ TEST(ShapeMeshTest, MissingAndEmptyObjFilesAreSceneErrors) {
 
 
 // --- Texture coordinates of the analytic shapes (Mitsuba's parameterisations) ---
+// Stored as (u, 1 - v): Mitsuba's v = 0 is an image's top row, Texture's the bottom row.
 
 TEST(ShapeMeshTest, RectangleTexcoordsFollowMitsuba) {
     const auto m = buildShapeMesh(shape(Kind::Rectangle));
     ASSERT_EQ(m.texcoords.size(), m.positions.size());
     for (size_t v = 0; v < m.positions.size(); ++v)
-        EXPECT_EQ(m.texcoords[v], Vec2((m.positions[v].x + 1) / 2, (m.positions[v].y + 1) / 2));
+        EXPECT_EQ(m.texcoords[v], Vec2((m.positions[v].x + 1) / 2, 1 - (m.positions[v].y + 1) / 2));
     // uv belongs to the object-space corner, whatever toWorld does (here a mirror).
     const auto mirrored = buildShapeMesh(shape(Kind::Rectangle, Transform::scale(Vec3(-2, 1, 1))));
     for (size_t v = 0; v < mirrored.positions.size(); ++v)
-        EXPECT_EQ(mirrored.texcoords[v], Vec2((-mirrored.positions[v].x / 2 + 1) / 2, (mirrored.positions[v].y + 1) / 2));
+        EXPECT_EQ(mirrored.texcoords[v], Vec2((-mirrored.positions[v].x / 2 + 1) / 2, 1 - (mirrored.positions[v].y + 1) / 2));
     // Interpolated inside a triangle: the centre of the square, halfway from corner 0 to
     // corner 2 of triangle 0, maps to (0.5, 0.5).
     EXPECT_EQ(m.texcoord(0, 0.0f, 0.5f), Vec2(0.5f, 0.5f));
@@ -331,7 +332,7 @@ TEST(ShapeMeshTest, CubeTexcoordsMapEveryFaceOntoTheUnitSquare) {
     // Mitsuba's +z face: (1,-1,1) -> (0,1), (1,1,1) -> (1,1), (-1,1,1) -> (1,0), (-1,-1,1) -> (0,0).
     for (size_t v = 12; v < 16; ++v) {
         ASSERT_EQ(m.positions[v].z, 1.0f);
-        EXPECT_EQ(m.texcoords[v], Vec2((m.positions[v].y + 1) / 2, (m.positions[v].x + 1) / 2)) << "vertex " << v;
+        EXPECT_EQ(m.texcoords[v], Vec2((m.positions[v].y + 1) / 2, 1 - (m.positions[v].x + 1) / 2)) << "vertex " << v;
     }
 }
 
@@ -344,7 +345,7 @@ TEST(ShapeMeshTest, SphereTexcoordsArePhiAndTheta) {
     for (size_t v = 0; v < m.positions.size(); ++v) {
         const Vec3 d = (m.positions[v] - s.center) / s.radius;
         const Vec2 uv = m.texcoords[v];
-        EXPECT_NEAR(uv.y, std::acos(std::clamp(d.z, -1.0f, 1.0f)) / M_PI, 1e-5) << "vertex " << v;
+        EXPECT_NEAR(1 - uv.y, std::acos(std::clamp(d.z, -1.0f, 1.0f)) / M_PI, 1e-5) << "vertex " << v;
         if (std::hypot(d.x, d.y) < 1e-3f) continue;  // poles: phi undefined
         float phi = std::atan2(d.y, d.x);
         if (phi < 0) phi += 2 * float(M_PI);
@@ -371,7 +372,7 @@ TEST(ShapeMeshTest, DiskTexcoordsAreRadiusAndAngle) {
         if (r < 0.5f) continue;
         float phi = std::atan2(p.y, p.x);
         if (phi < -1e-6f) phi += 2 * float(M_PI);
-        const float v01 = m.texcoords[v].y;
+        const float v01 = 1 - m.texcoords[v].y;
         EXPECT_TRUE(std::abs(v01 - phi / (2 * float(M_PI))) < 1e-5f || (v01 == 1.0f && std::abs(phi) < 1e-5f))
             << "vertex " << v;
     }
@@ -494,7 +495,9 @@ TEST(ShapeMeshTest, SerializedShapesAreTransformedToWorld) {
     const auto m = buildShapeMesh(s);
     ASSERT_EQ(m.triangles.size(), 2u);
     EXPECT_EQ(m.positions[2], Vec3(6, 1, 1));
-    EXPECT_EQ(m.texcoords, quad.texcoords);
+    ASSERT_EQ(m.texcoords.size(), quad.texcoords.size());
+    for (size_t v = 0; v < quad.texcoords.size(); ++v)  // Mitsuba's v = 0 is the top row: stored as 1 - v
+        EXPECT_EQ(m.texcoords[v], Vec2(quad.texcoords[v].x, 1 - quad.texcoords[v].y));
     ASSERT_EQ(m.normals.size(), 4u);
     const Vec3 tilted = Vec3(-1, 0, 1).normalized();
     EXPECT_LT((m.normals[0] - tilted).length(), 1e-6f);

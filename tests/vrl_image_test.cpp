@@ -6,6 +6,7 @@
 // image mean and each 8x8 block mean must agree within 5 combined standard
 // errors of the K-run means (Student t with K-1 = 7 dof: P(|t| > 5) = 0.0016
 // per comparison, about 2% over the 15 comparisons of one scene).
+#include "render/mitsuba_parser.h"
 #include "render/path_tracer.h"
 #include "render/renderer.h"
 #include "render/vrl_integrator.h"
@@ -15,6 +16,7 @@
 #include <tbb/parallel_for.h>
 
 #include <cmath>
+#include <filesystem>
 #include <vector>
 
 namespace vrl {
@@ -141,6 +143,18 @@ TEST(VrlImage, PartsSumToReferenceThroughGlassAndMirror) {
     ASSERT_TRUE(scene->hasSpecularSurfaces());
     expectAgree(vrlRuns(*scene, "surface,single,medium-surface,multiple", 16, kVrls),
                 referenceRuns(*scene, kReferenceSpp, false), "glass and mirror");
+}
+
+// The lajolla Cornell box (spectral reflectances, a medium around everything) as
+// written, at 16x16: the four-part VRL image equals the path tracer within noise.
+TEST(VrlImage, PartsSumToReferenceInSharedVolCbox) {
+    const std::filesystem::path file = std::filesystem::path(VRL_SHARED_SCENES_DIR) / "lajolla-volpath-test/vol_cbox.xml";
+    if (!std::filesystem::exists(file)) GTEST_SKIP() << "shared scene " << file << " is absent";
+    SceneDescription description = parseMitsubaScene(file);
+    description.sensor.width = description.sensor.height = 16;
+    const auto scene = Scene::build(description);
+    expectAgree(vrlRuns(*scene, "surface,single,medium-surface,multiple", 16, kVrls),
+                referenceRuns(*scene, kReferenceSpp, false), "vol_cbox");
 }
 
 TEST(VrlImage, PartsSumToReferenceInLitRoomWithOccluder) {
