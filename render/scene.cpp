@@ -95,13 +95,45 @@ bool isConvexClosed(const std::vector<const TriangleMesh*>& meshes) {
     return true;
 }
 
+// Media declared separately with equal coefficients and phase are one physical
+// medium (Mitsuba scenes often repeat an inline <medium> on every shape that
+// touches it): one index for all, so that crossings between them change nothing
+// and light-tree nodes and cluster bounds see a single medium.
+SceneDescription mergeIdenticalMedia(SceneDescription d) {
+    std::vector<int> canonical(d.media.size());
+    std::vector<MediumDescription> unique;
+    for (size_t i = 0; i < d.media.size(); ++i) {
+        const MediumDescription& m = d.media[i];
+        const auto same = std::find_if(unique.begin(), unique.end(), [&](const MediumDescription& u) {
+            return u.sigmaS == m.sigmaS && u.sigmaA == m.sigmaA && u.phase.kind == m.phase.kind && u.phase.g == m.phase.g;
+        });
+        canonical[i] = int(same - unique.begin());
+        if (same == unique.end()) unique.push_back(m);
+    }
+    if (unique.size() == d.media.size()) return d;
+    spdlog::info("{}: {} media declared, {} distinct: identical ones are treated as one", d.file.string(),
+                 d.media.size(), unique.size());
+    const auto remap = [&](int& index) {
+        if (index >= 0 && index < int(canonical.size())) index = canonical[index];
+    };
+    remap(d.sensor.medium);
+    for (auto& s : d.shapes) {
+        remap(s.interiorMedium);
+        remap(s.exteriorMedium);
+    }
+    for (auto& e : d.emitters) remap(e.medium);
+    d.media = std::move(unique);
+    return d;
+}
+
 }  // namespace
 
 Scene::Scene(const SceneDescription& description) : description_(description), camera_(description.sensor) {}
 
 Scene::~Scene() = default;
 
-std::unique_ptr<Scene> Scene::build(const SceneDescription& description) {
+std::unique_ptr<Scene> Scene::build(const SceneDescription& declared) {
+    const SceneDescription description = mergeIdenticalMedia(declared);
     std::unique_ptr<Scene> scene(new Scene(description));
     for (const auto& m : description.media) {
         try {

@@ -41,8 +41,10 @@ struct SurfaceHit {
 
 class Scene {
 public:
-    // Loads meshes and builds the BVH. Throws SceneError for problems in the
-    // description (missing meshes, invalid media) and std::runtime_error for Embree failures.
+    // Loads meshes and builds the BVH. Media with equal coefficients and phase are
+    // merged into one (description() and media() hold the merged list). Throws
+    // SceneError for problems in the description (missing meshes, invalid media) and
+    // std::runtime_error for Embree failures.
     static std::unique_ptr<Scene> build(const SceneDescription& description);
     ~Scene();
     Scene(const Scene&) = delete;

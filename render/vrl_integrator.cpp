@@ -15,7 +15,8 @@ VrlIntegrator::VrlIntegrator(const Scene& scene, const VrlSet& vrls, const VrlIn
       estimator_(scene, settings.vrlSamples),
       tree_(tree) {
     if (tree_) lightcuts_ = std::make_unique<LightcutsEstimator>(scene, *tree_, estimator_, settings.cut);
-    if (settings.maxDepth >= 0 && scene.hasSpecularSurfaces() && settings.transports.has(TransportPart::Multiple))
+    if (settings.maxDepth >= 0 && settings.maxDepth < 16 && scene.hasSpecularSurfaces() &&
+        settings.transports.has(TransportPart::Multiple))
         spdlog::warn("maxDepth {} with specular surfaces: multiple scattering (d) seen through glass or mirrors "
                      "does not count the specular bounces towards maxDepth", settings.maxDepth);
 }
