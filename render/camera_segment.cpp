@@ -28,9 +28,10 @@ std::vector<CameraSegment> cameraSegments(const Scene& scene, const Ray& cameraR
             Scene::continuePast(ray, *hit);
             continue;
         }
-        // A specular bounce is a path vertex: the next segment needs room for two more.
+        // A specular bounce is a path vertex: after it, a medium vertex on the next
+        // segment and a light still need to fit (specular + 1 + 2 segments).
         if (!rng || !bsdf.isPurelySpecular() || specular >= kMaxSpecularChain) break;
-        if (maxDepth >= 0 && specular + 2 > maxDepth) break;
+        if (maxDepth >= 0 && specular + 3 > maxDepth) break;
         const auto sampled = bsdf.sample(hit->shadingPoint(), -ray.direction, Vec2(rng->next(), rng->next()),
                                          rng->next(), TransportMode::Radiance);
         if (!sampled || isBlack(sampled->weight)) break;

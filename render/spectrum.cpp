@@ -317,6 +317,7 @@ Rgb xyzToLinearSrgb(const Imath::V3f& c) {
 
 Rgb spectrumToRgb(std::span<const SpectralSample> samples) {
     const Rgb rgb = xyzToLinearSrgb(spectrumToXyz(samples));
+    if (!isFinite(rgb)) throw std::invalid_argument("the spectrum's values are too large: its colour overflows");
     return {std::max(rgb.x, 0.0f), std::max(rgb.y, 0.0f), std::max(rgb.z, 0.0f)};
 }
 

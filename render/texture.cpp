@@ -38,11 +38,14 @@ struct Transfer {
     Kind kind = Kind::Linear;
     float gamma = 1.0f;
 
+    // Negative stored values (possible in float images) become 0: a texture is a
+    // reflectance and must not make a path's throughput negative.
     float operator()(float c) const {
+        c = std::max(c, 0.0f);
         switch (kind) {
         case Kind::Linear: return c;
         case Kind::Srgb: return srgbToLinear(c);
-        case Kind::Power: return std::copysign(std::pow(std::abs(c), gamma), c);
+        case Kind::Power: return std::pow(c, gamma);
         }
         return c;
     }
