@@ -105,7 +105,7 @@ public:
             ++vertices;
             const auto sampled = shape.bsdf.sample(hit->shadingPoint(), -ray.direction, Vec2(rng.next(), rng.next()),
                                                    rng.next(), TransportMode::Importance);
-            if (!sampled || isBlack(sampled->weight) || !isFinite(sampled->weight)) return;
+            if (!sampled || isBlack(sampled->weight)) return;  // Bsdf::sample returns finite weights
             throughput *= sampled->weight;
             const Vec3 dir = sampled->wi;
             medium = scene_.mediumAfter(*hit, dir, medium);

@@ -304,8 +304,11 @@ Imath::V3f spectrumToXyz(std::span<const SpectralSample> samples) {
                       (sa * cmf(tables[c], a) + 4.0 * sm * cmf(tables[c], m) + sb * cmf(tables[c], b));
     }
     // ∫ ȳ over 360–830 nm of the interpolated table (the trapezoid rule is exact for it).
-    double yIntegral = 0.0;
-    for (int i = 0; i + 1 < kCieSamples; ++i) yIntegral += 0.5 * (double(kCieY[i]) + kCieY[i + 1]);
+    static const double yIntegral = [] {
+        double sum = 0.0;
+        for (int i = 0; i + 1 < kCieSamples; ++i) sum += 0.5 * (double(kCieY[i]) + kCieY[i + 1]);
+        return sum;
+    }();
     return {float(xyz[0] / yIntegral), float(xyz[1] / yIntegral), float(xyz[2] / yIntegral)};
 }
 
