@@ -183,7 +183,7 @@ int runRender(const RenderCommandOptions& o) {
     images.metadata["vrl.time.parse"] = std::to_string(parseSeconds);
     images.metadata["vrl.time.build"] = std::to_string(buildSeconds);
     images.metadata["vrl.time.render"] = std::to_string(stats.seconds);
-    if (settings.method == "vrl-lightcuts") {
+    if (usesLightTree(settings.method)) {
         images.metadata["vrl.error"] = std::to_string(o.error);
         images.metadata["vrl.maxCut"] = std::to_string(o.maxCut);
         images.metadata["vrl.exactDistanceBelow"] = std::to_string(o.exactDistanceBelow);
@@ -219,7 +219,7 @@ int runRender(const RenderCommandOptions& o) {
                      double(stats.vrlBytes) / (1024.0 * 1024.0), sizeof(Vrl));
         std::fprintf(stderr, "  transport parts: %s\n", settings.transports.toString().c_str());
     }
-    if (settings.method == "vrl-lightcuts") {
+    if (usesLightTree(settings.method)) {
         std::fprintf(stderr, "  light tree %.3f s, %.1f MiB; per pixel: #Eval %.1f, #Inter %.1f, cut size %.1f\n",
                      stats.treeSeconds, double(stats.treeBytes) / (1024.0 * 1024.0), stats.meanEvaluated,
                      stats.meanIntersected, stats.meanCutSize);

@@ -21,8 +21,10 @@ void addRenderOptions(CLI::App& cmd, RenderCommandOptions& o) {
                     "of luminance maps near white)");
     cmd.add_option("--method", o.method,
                     "Rendering method: path (volumetric path tracer, the reference), vrl (transport parts "
-                    "(a)-(c) by path sampling, multiple scattering (d) by plain VRLs) or vrl-lightcuts (the same, "
-                    "(d) by cuts through a VRL light tree)")
+                    "(a)-(c) by path sampling, multiple scattering (d) by plain VRLs), vrl-lightcuts (the same, "
+                    "(d) by cuts through a VRL light tree) or vpl-lightcuts (the paper's baseline: (d) by Lightcuts "
+                    "over VPLs at the light paths' medium collisions, 32 stratified distance samples per camera "
+                    "segment, no clamping)")
         ->check(CLI::IsMember(kRenderMethods));
     cmd.add_option("--spp", o.spp, "Samples per pixel (default: the scene's sampler sampleCount)")
         ->check(CLI::Range(1, kMaxSampleCount));
@@ -39,7 +41,8 @@ void addRenderOptions(CLI::App& cmd, RenderCommandOptions& o) {
                                                                      : std::string("must be -1 or 1..100000");
             },
             "-1 or 1..100000"));
-    cmd.add_option("--vrls", o.vrls, "vrl: target number of VRLs; whole light paths are traced until reached")
+    cmd.add_option("--vrls", o.vrls, "vrl, vrl-lightcuts: target number of VRLs (vpl-lightcuts: of VPLs); whole light paths are traced "
+                   "until reached (default 100000)")
         ->check(CLI::Range(uint64_t(1), uint64_t(1) << 32));
     cmd.add_option("--light-paths", o.lightPaths, "vrl: trace exactly this many light paths (overrides --vrls)")
         ->check(CLI::Range(uint64_t(1), uint64_t(1) << 40));
@@ -49,20 +52,21 @@ void addRenderOptions(CLI::App& cmd, RenderCommandOptions& o) {
                     "vrl: parts to render, comma-separated: surface (a), single (b), medium-surface (c), multiple (d); "
                     "each is also written as an EXR layer (default: all four)");
     cmd.add_option("--error", o.error,
-                    "vrl-lightcuts: relative error threshold; a node is refined while its bound exceeds this times "
+                    "vrl-lightcuts, vpl-lightcuts: relative error threshold; a node is refined while its bound exceeds this times "
                     "the current estimate (default 0.02)")
         ->check(CLI::Range(0.0f, 1e6f));
-    cmd.add_option("--max-cut", o.maxCut, "vrl-lightcuts: most nodes in one cut, a safety valve (default 4096)")
+    cmd.add_option("--max-cut", o.maxCut, "vrl-lightcuts, vpl-lightcuts: most nodes in one cut, a safety valve (default 4096)")
         ->check(CLI::Range(1u, 1u << 30));
     cmd.add_option("--exact-distance-below", o.exactDistanceBelow,
                     "vrl-lightcuts: nodes with at most this many VRLs take their distance to the camera ray from "
                     "their VRLs rather than their box (default 32)")
         ->check(CLI::Range(0u, 1u << 20));
     cmd.add_option("--hg-epsilon", o.hgEpsilon,
-                    "vrl-lightcuts: Henyey-Greenstein media multiply the isotropic bound by (1 + this) (default 1)")
+                    "vrl-lightcuts, vpl-lightcuts: Henyey-Greenstein media multiply the isotropic bound by (1 + this) "
+                   "(default 1)")
         ->check(CLI::Range(0.0f, 1e6f));
     cmd.add_option("--partition-size", o.partitionSize,
-                    "vrl-lightcuts: VRLs per partition before agglomerative clustering (default 2048)")
+                    "vrl-lightcuts, vpl-lightcuts: lights per partition before agglomerative clustering (default 2048)")
         ->check(CLI::Range(2u, 1u << 30));
     cmd.add_flag("--jitter", o.jitter, "Jitter camera rays inside pixels (default: through pixel centres)");
     cmd.add_flag("-q,--quiet", o.quiet, "No progress bar and no informational logs");

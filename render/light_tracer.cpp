@@ -42,6 +42,7 @@ public:
         int vertices = 0;  // real scattering vertices so far; the current segment is number vertices + 1
         float segmentStart = 0.0f;
         int mediumBeforeCrossing = medium;  // before the last null boundary crossed
+        const bool points = settings_.deposit == LightDeposit::Points;
         const auto keepsVrls = [&] { return settings_.maxDepth < 0 || vertices + 3 <= settings_.maxDepth; };
         const auto roulette = [&] {
             if (vertices < settings_.rouletteDepth) return true;
@@ -68,9 +69,10 @@ public:
                     while (true) {
                         const float t = segmentStart - std::log1p(-rng.next()) / majorant;
                         const float end = std::min(t, tSurface);
-                        if (std::isfinite(end) && end > segmentStart)
+                        if (!points && std::isfinite(end) && end > segmentStart)
                             out.push_back({ray.at(segmentStart), ray.direction, end - segmentStart, throughput, medium});
                         if (t >= tSurface) break;
+                        if (points) out.push_back({ray.at(t), ray.direction, 0.0f, throughput * sigmaS / majorant, medium});
                         segmentStart = t;
                         if (rng.next() < pReal) {
                             throughput *= sigmaS / (majorant * pReal);

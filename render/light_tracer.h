@@ -18,7 +18,20 @@
 
 namespace vrl {
 
+// What light tracing deposits: short VRLs (every collision-free stretch of a
+// path in a scattering medium), or VPLs for the VPL Lightcuts baseline.
+enum class LightDeposit {
+    Segments,
+    // One VPL at every collision sampled in a scattering medium (real or null),
+    // stored as a Vrl of length 0 at the collision, `direction` the path's
+    // direction before it, flux = (flux of the segment ending there) x
+    // sigma_s / majorant: the collision estimator of the same segment's VRL
+    // integral, so VPLs and VRLs of one path estimate the same light.
+    Points,
+};
+
 struct LightTracingSettings {
+    LightDeposit deposit = LightDeposit::Segments;
     uint64_t lightPaths = 0;  // trace exactly this many paths, or (if 0) ...
     uint64_t targetVrls = 100000;  // ... whole batches of paths until this many VRLs
     // Mitsuba's maxDepth for the full camera path. A VRL that is the j-th

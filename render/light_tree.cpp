@@ -23,7 +23,8 @@ Imath::Box3f segmentBox(const Vrl& v) {
 
 // Joins two nodes into a new inner node (not yet placed).
 LightTreeNode joinNodes(const LightTreeNode& a, int32_t aIndex, const LightTreeNode& b, int32_t bIndex,
-                        const std::vector<Vrl>& vrls, uint64_t seed) {
+                        const std::vector<Vrl>& vrls, const LightTreeSettings& settings) {
+    const uint64_t seed = settings.seed;
     LightTreeNode n;
     n.box = a.box;
     n.box.extendBy(b.box);
@@ -38,7 +39,10 @@ LightTreeNode joinNodes(const LightTreeNode& a, int32_t aIndex, const LightTreeN
     const float pa = wa + wb > 0.0f ? wa / (wa + wb) : 0.5f;
     n.representative = rng.next() < pa ? a.representative : b.representative;
     const float repLength = vrls[n.representative].length;
-    n.clusterFlux = repLength > 0.0f ? n.fluxLength / repLength : Rgb(0.0f);
+    if (settings.points)
+        n.clusterFlux = n.fluxLength;
+    else
+        n.clusterFlux = repLength > 0.0f ? n.fluxLength / repLength : Rgb(0.0f);
     return n;
 }
 
@@ -56,7 +60,7 @@ LightTreeNode joinNodes(const LightTreeNode& a, int32_t aIndex, const LightTreeN
 // vectorised pass.
 template <class Lookup>
 int32_t agglomerate(const std::vector<int32_t>& inputs, Lookup&& lookup, int32_t firstNewIndex,
-                    std::vector<LightTreeNode>& out, const std::vector<Vrl>& vrls, uint64_t seed) {
+                    std::vector<LightTreeNode>& out, const std::vector<Vrl>& vrls, const LightTreeSettings& settings) {
     const size_t n = inputs.size();
     if (n == 0) return -1;
     if (n == 1) return inputs[0];
@@ -119,7 +123,7 @@ int32_t agglomerate(const std::vector<int32_t>& inputs, Lookup&& lookup, int32_t
             inChain[partner] = 0;
         }
         const int32_t index = firstNewIndex + int32_t(out.size());
-        out.push_back(joinNodes(lookup(node[a]), node[a], lookup(node[partner]), node[partner], vrls, seed));
+        out.push_back(joinNodes(lookup(node[a]), node[a], lookup(node[partner]), node[partner], vrls, settings));
         node[a] = index;
         load(positionOf[a], out.back());
         const size_t hole = positionOf[partner], last = live - 1;
@@ -206,7 +210,7 @@ LightTree LightTree::build(std::vector<Vrl> vrls, const LightTreeSettings& setti
     tbb::parallel_for(size_t(0), count, [&](size_t i) {
         LightTreeNode& leaf = tree.nodes_[i];
         leaf.box = segmentBox(v[i]);
-        leaf.fluxLength = v[i].flux * v[i].length;
+        leaf.fluxLength = settings.points ? v[i].flux : v[i].flux * v[i].length;
         leaf.clusterFlux = v[i].flux;
         leaf.maxLength = v[i].length;
         leaf.representative = uint32_t(i);
@@ -232,7 +236,7 @@ LightTree LightTree::build(std::vector<Vrl> vrls, const LightTreeSettings& setti
         out.reserve(inputs.size());
         localRoot[p] = agglomerate(
             inputs, [&](int32_t i) -> const LightTreeNode& { return i < localBase ? tree.nodes_[i] : out[i - localBase]; },
-            localBase, out, v, settings.seed);
+            localBase, out, v, settings);
     });
     // Append partitions in order, remapping local indices to global ones.
     std::vector<int32_t> roots;
@@ -252,7 +256,7 @@ LightTree LightTree::build(std::vector<Vrl> vrls, const LightTreeSettings& setti
     const int32_t topBase = int32_t(tree.nodes_.size());
     const int32_t root = agglomerate(
         roots, [&](int32_t i) -> const LightTreeNode& { return i < topBase ? tree.nodes_[i] : top[i - topBase]; },
-        topBase, top, v, settings.seed);
+        topBase, top, v, settings);
     tree.nodes_.insert(tree.nodes_.end(), top.begin(), top.end());
     tree.root_ = root;
     tree.nodes_.shrink_to_fit();

@@ -44,6 +44,10 @@ struct LightTreeNode {
 struct LightTreeSettings {
     uint32_t partitionSize = 2048;  // VRLs per partition of the median-split phase
     uint64_t seed = 0;              // representative choice
+    // Point clusters (VPL Lightcuts): the VRLs are VPLs of length 0 and every
+    // weight is the flux itself (fluxLength holds the summed flux, clusterFlux
+    // equals it), as in Walter et al. 2005.
+    bool points = false;
 };
 
 class LightTree {

@@ -26,7 +26,7 @@ Ray cameraRay(const PerspectiveCamera& camera, const RenderSettings& settings, i
 }
 
 bool isVrlMethod(const RenderSettings& settings) {
-    return settings.method == "vrl" || settings.method == "vrl-lightcuts";
+    return settings.method == "vrl" || usesLightTree(settings.method);
 }
 
 }  // namespace
@@ -40,6 +40,7 @@ void validateRenderSettings(const RenderSettings& settings) {
     if (settings.samplesPerPixel < 1) throw std::invalid_argument("samples per pixel must be at least 1");
     if (settings.vrlSamples < 1) throw std::invalid_argument("samples per VRL must be at least 1");
     if (!(settings.cut.errorThreshold >= 0.0f)) throw std::invalid_argument("the error threshold must be >= 0");
+    if (settings.vplDistanceSamples < 1) throw std::invalid_argument("VPL distance samples must be at least 1");
 }
 
 RenderLights prepareLights(const Scene& scene, const RenderSettings& settings, const ProgressCallback& progress,
@@ -54,6 +55,8 @@ RenderLights prepareLights(const Scene& scene, const RenderSettings& settings, c
     tracing.targetVrls = settings.vrlCount;
     tracing.maxDepth = settings.maxDepth;
     tracing.seed = settings.seed ^ 0x5bd1e995ULL;  // a stream family apart from the camera's
+    const bool points = settings.method == "vpl-lightcuts";
+    if (points) tracing.deposit = LightDeposit::Points;
     lights.vrls = traceVrls(scene, tracing, [&](double f) {
         if (progress) progress("light tracing", f);
     });
@@ -61,11 +64,12 @@ RenderLights prepareLights(const Scene& scene, const RenderSettings& settings, c
     stats.lightPaths = lights.vrls.lightPaths;
     stats.vrlBytes = lights.vrls.memoryBytes();
     stats.tracingSeconds = lights.vrls.tracingSeconds;
-    if (settings.method == "vrl-lightcuts" && !lights.vrls.vrls.empty()) {
+    if (usesLightTree(settings.method) && !lights.vrls.vrls.empty()) {
         if (progress) progress("building the light tree", 0.0);
         const auto treeStart = std::chrono::steady_clock::now();
         // The tree takes the VRLs over: shading reads them from it.
-        lights.tree = LightTree::build(std::move(lights.vrls.vrls), LightTreeSettings{settings.partitionSize, settings.seed});
+        lights.tree = LightTree::build(std::move(lights.vrls.vrls),
+                                       LightTreeSettings{settings.partitionSize, settings.seed, points});
         lights.vrls.vrls = {};
         stats.treeSeconds = secondsSince(treeStart);
         stats.treeBytes = lights.tree.memoryBytes();
@@ -89,7 +93,7 @@ std::vector<std::string> renderLayerNames(const RenderSettings& settings) {
     if (!isVrlMethod(settings)) return names;
     for (size_t p = 0; p < kTransportPartNames.size(); ++p)
         if (settings.transports.enabled[p]) names.emplace_back(kTransportPartNames[p]);
-    if (settings.method == "vrl-lightcuts")
+    if (usesLightTree(settings.method))
         for (const char* name : kCutLayerNames) names.emplace_back(name);
     return names;
 }
@@ -97,9 +101,11 @@ std::vector<std::string> renderLayerNames(const RenderSettings& settings) {
 TileShader::TileShader(const Scene& scene, const RenderSettings& settings, const RenderLights& lights)
     : scene_(scene), settings_(settings), layerNames_(renderLayerNames(settings)) {
     if (isVrlMethod(settings)) {
-        const bool lightcuts = settings.method == "vrl-lightcuts";
-        const VrlIntegratorSettings integratorSettings{settings.transports, settings.maxDepth, settings.vrlSamples,
-                                                       settings.cut};
+        const bool lightcuts = usesLightTree(settings.method);
+        VrlIntegratorSettings integratorSettings{settings.transports, settings.maxDepth, settings.vrlSamples,
+                                                 settings.cut};
+        integratorSettings.vplLightcuts = settings.method == "vpl-lightcuts";
+        integratorSettings.vplDistanceSamples = settings.vplDistanceSamples;
         integrator_ = std::make_unique<VrlIntegrator>(scene, lights.vrls, integratorSettings,
                                                       lightcuts && lights.tree.root() >= 0 ? &lights.tree : nullptr);
     } else {
@@ -147,7 +153,7 @@ TileImages TileShader::renderTile(const TileRect& tile) const {
                 out.layers[layer++].at(tx, ty) = parts[p];
             }
             out.layers[0].at(tx, ty) = sum;
-            if (settings_.method == "vrl-lightcuts") {
+            if (usesLightTree(settings_.method)) {
                 out.layers[layer++].at(tx, ty) = Rgb(float(cut.evaluated));
                 out.layers[layer++].at(tx, ty) = Rgb(float(cut.intersected));
                 out.layers[layer++].at(tx, ty) = Rgb(float(cut.cutSize));

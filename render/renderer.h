@@ -24,7 +24,12 @@ namespace vrl {
 //   vrl:  the four transport parts, multiple scattering by plain VRLs; one layer per part
 //   vrl-lightcuts: the same, multiple scattering by cuts through a VRL light tree,
 //         plus per-pixel layers "eval", "inter" and "cut" (statistics)
-inline const std::vector<std::string> kRenderMethods = {"path", "vrl", "vrl-lightcuts"};
+//   vpl-lightcuts: the same layers, multiple scattering by VPL Lightcuts (the
+//         paper's baseline, vpl_lightcuts.h); vrlCount is then the number of VPLs
+inline const std::vector<std::string> kRenderMethods = {"path", "vrl", "vrl-lightcuts", "vpl-lightcuts"};
+
+// The method builds a light tree (VRL or VPL Lightcuts): it ships a tree, not a VRL set.
+inline bool usesLightTree(const std::string& method) { return method == "vrl-lightcuts" || method == "vpl-lightcuts"; }
 
 struct RenderSettings {
     std::string method = "path";
@@ -40,6 +45,7 @@ struct RenderSettings {
     int vrlSamples = 1;          // (u, v) samples per VRL and camera segment
     // vrl-lightcuts method
     CutSettings cut;             // error threshold, maximum cut, bound parameters
+    int vplDistanceSamples = 32;  // vpl-lightcuts: stratified distance samples per camera segment
     uint32_t partitionSize = 2048;  // light tree: VRLs per partition of the median-split phase
 };
 

@@ -14,7 +14,10 @@ VrlIntegrator::VrlIntegrator(const Scene& scene, const VrlSet& vrls, const VrlIn
       tracer_(scene, PathTracerSettings{settings.maxDepth}),
       estimator_(scene, settings.vrlSamples),
       tree_(tree) {
-    if (tree_) lightcuts_ = std::make_unique<LightcutsEstimator>(scene, *tree_, estimator_, settings.cut);
+    if (tree_ && settings.vplLightcuts)
+        vplLightcuts_ = std::make_unique<VplLightcutsEstimator>(scene, *tree_, settings.cut, settings.vplDistanceSamples);
+    else if (tree_)
+        lightcuts_ = std::make_unique<LightcutsEstimator>(scene, *tree_, estimator_, settings.cut);
     if (settings.maxDepth >= 0 && settings.maxDepth < 16 && scene.hasSpecularSurfaces() &&
         settings.transports.has(TransportPart::Multiple))
         spdlog::warn("maxDepth {} with specular surfaces: multiple scattering (d) seen through glass or mirrors "
@@ -97,7 +100,10 @@ Rgb VrlIntegrator::multipleScattering(const Ray& cameraRay, Rng& rng, CutStatist
     for (const CameraSegment& segment : cameraSegments(scene_, cameraRay, scene_.cameraMedium(), &rng, settings_.maxDepth)) {
         const uint64_t streamKey = Rng::combine(pixelKey, segmentIndex++);
         if (scene_.media()[segment.medium].isNonScattering()) continue;
-        if (lightcuts_) {
+        if (vplLightcuts_) {
+            Rng segmentRng = vrlStream(streamKey, ~0u);
+            sum += vplLightcuts_->estimate(segment, segmentRng, statistics ? *statistics : unused);
+        } else if (lightcuts_) {
             sum += lightcuts_->estimate(segment, streamKey, statistics ? *statistics : unused);
         } else {
             const auto& vrls = tree_ ? tree_->vrls() : vrls_.vrls;

@@ -5,7 +5,8 @@
 // (c) samples a point on the segment in proportion to transmittance, a
 // direction by the phase function, and path-traces from the surface that
 // direction reaches (exact transmittance in between, no emission there: (b)
-// has it); (d) sums the VRL estimator over every VRL (plain VRLs, --method vrl).
+// has it); (d) sums the VRL estimator over every VRL (plain VRLs, --method vrl),
+// walks Lightcuts over a VRL tree (vrl-lightcuts) or over a VPL tree (vpl-lightcuts).
 // Each part is estimated for paths its siblings leave out, so the parts add up
 // to the reference path tracer's image. Camera paths continue through purely
 // specular surfaces (camera_segment.h): parts (b)-(d) shade every medium
@@ -19,6 +20,7 @@
 #include "render/path_tracer.h"
 #include "render/transport.h"
 #include "render/vrl.h"
+#include "render/vpl_lightcuts.h"
 #include "render/vrl_estimator.h"
 
 #include <array>
@@ -31,6 +33,9 @@ struct VrlIntegratorSettings {
     int maxDepth = -1;
     int vrlSamples = 1;  // (u, v) samples per VRL and camera segment
     CutSettings cut;     // used when a light tree is given
+    // With a tree: it holds VPLs and (d) is VPL Lightcuts (vpl_lightcuts.h).
+    bool vplLightcuts = false;
+    int vplDistanceSamples = 32;  // distance samples per camera segment (VPL Lightcuts)
 };
 
 class VrlIntegrator {
@@ -55,6 +60,7 @@ private:
     VrlEstimator estimator_;
     const LightTree* tree_;
     std::unique_ptr<LightcutsEstimator> lightcuts_;
+    std::unique_ptr<VplLightcutsEstimator> vplLightcuts_;
 };
 
 }  // namespace vrl

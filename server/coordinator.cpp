@@ -742,7 +742,7 @@ void Coordinator::finishJob(Job& job) {
         images.metadata["vrl.vrls"] = std::to_string(stats.vrlCount);
         images.metadata["vrl.lightPaths"] = std::to_string(stats.lightPaths);
     }
-    if (p.method() == "vrl-lightcuts") {
+    if (usesLightTree(p.method())) {
         images.metadata["vrl.error"] = std::to_string(p.error());
         images.metadata["vrl.meanEval"] = std::to_string(stats.meanEvaluated);
         images.metadata["vrl.meanInter"] = std::to_string(stats.meanIntersected);

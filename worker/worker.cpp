@@ -240,7 +240,7 @@ std::shared_ptr<const Worker::JobContext> Worker::loadJob(const std::string& job
         if (!assets.lights_sha256().empty()) {
             const std::string blob = fetcher_->fetch(assets.lights_sha256(), assets.lights_size());
             const auto* data = reinterpret_cast<const uint8_t*>(blob.data());
-            if (assets.spec().parameters().method() == "vrl-lightcuts")
+            if (usesLightTree(assets.spec().parameters().method()))
                 context->lights.tree = deserializeLightTree(data, blob.size());
             else
                 context->lights.vrls = deserializeVrlSet(data, blob.size());

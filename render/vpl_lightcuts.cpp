@@ -1,0 +1,156 @@
+#include "render/vpl_lightcuts.h"
+
+#include "render/scene.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <queue>
+#include <stdexcept>
+#include <vector>
+
+namespace vrl {
+
+namespace {
+constexpr double kRoundingMargin = 1.001;
+constexpr float kInv4PiF = 0.0795774715459476678f;
+}  // namespace
+
+double distancePointBox(const Vec3& point, const Imath::Box3f& box) {
+    double d2 = 0.0;
+    for (int a = 0; a < 3; ++a) {
+        const double p = point[a];
+        const double gap = std::max({double(box.min[a]) - p, 0.0, p - double(box.max[a])});
+        d2 += gap * gap;
+    }
+    return std::sqrt(d2);
+}
+
+VplLightcutsEstimator::VplLightcutsEstimator(const Scene& scene, const LightTree& tree, CutSettings settings,
+                                             int distanceSamples)
+    : scene_(scene), tree_(tree), settings_(settings), distanceSamples_(distanceSamples) {
+    if (distanceSamples_ < 1) throw std::invalid_argument("VPL Lightcuts needs at least one distance sample");
+}
+
+Rgb VplLightcutsEstimator::vplContribution(const Vrl& vpl, const Rgb& flux, const Vec3& x, const Vec3& toCamera,
+                                           int medium) const {
+    const Vec3 d = x - vpl.origin;
+    const float w2 = d.length2();
+    if (!(w2 > 0.0f) || !std::isfinite(w2)) return Rgb(0.0f);
+    const float w = std::sqrt(w2);
+    const Vec3 toX = d / w;
+    const HomogeneousMedium& mediumX = scene_.media()[medium];
+    const HomogeneousMedium& mediumV = scene_.media()[vpl.medium];
+    const float phase = mediumV.phase().eval(vpl.direction, toX) * mediumX.phase().eval(toX, toCamera);
+    if (!(phase > 0.0f)) return Rgb(0.0f);
+    const Rgb between = vpl.medium == medium && !scene_.mediumNeedsVisibility(medium)
+                            ? mediumX.transmittance(w)
+                            : scene_.transmittance(x, vpl.origin, medium);
+    if (isBlack(between)) return Rgb(0.0f);
+    return flux * between * (phase / w2);
+}
+
+Rgb VplLightcutsEstimator::bound(int32_t index, const Vec3& x, int medium) const {
+    const LightTreeNode& node = tree_.nodes()[index];
+    const float reach = std::max({std::abs(node.box.min.x), std::abs(node.box.min.y), std::abs(node.box.min.z),
+                                  std::abs(node.box.max.x), std::abs(node.box.max.y), std::abs(node.box.max.z)});
+    const double slack = 8.0 * 0x1p-24 * (double(x.length()) + reach);
+    const double d = distancePointBox(x, node.box) - slack;
+    if (!(d > 0.0)) return Rgb(std::numeric_limits<float>::infinity());
+    const HomogeneousMedium& mediumX = scene_.media()[medium];
+    bool isotropic = mediumX.phase().isIsotropic();
+    if (node.medium >= 0)
+        isotropic = isotropic && scene_.media()[node.medium].phase().isIsotropic();
+    else
+        for (const auto& m : scene_.media()) isotropic = isotropic && m.phase().isIsotropic();
+    double phase = double(kInv4PiF) * double(kInv4PiF);
+    if (!isotropic) phase *= 1.0 + settings_.bound.anisotropyEpsilon;
+    Rgb between(1.0f);
+    if (node.medium == medium && mediumX.boundaryConvex()) between = mediumX.transmittance(float(d));
+    return node.clusterFlux * between * float(kRoundingMargin * phase / (d * d));
+}
+
+Rgb VplLightcutsEstimator::gather(const Vec3& x, const Vec3& toCamera, int medium, CutStatistics& statistics) const {
+    if (tree_.empty()) return Rgb(0.0f);
+    struct CutNode {
+        float bound;
+        int32_t node;
+        Rgb estimate;
+        bool operator<(const CutNode& o) const { return bound != o.bound ? bound < o.bound : node > o.node; }
+    };
+    std::priority_queue<CutNode> heap;
+    Rgb total(0.0f);
+    uint32_t leavesInCut = 0;
+    const auto& nodes = tree_.nodes();
+    const auto& vpls = tree_.vrls();
+    std::vector<int32_t> pending;
+    const auto addToCut = [&](int32_t first) {
+        pending.push_back(first);
+        while (!pending.empty()) {
+            const int32_t i = pending.back();
+            pending.pop_back();
+            const LightTreeNode& node = nodes[i];
+            const Vrl& representative = vpls[node.representative];
+            ++statistics.evaluated;
+            if (node.isLeaf()) {
+                total += vplContribution(representative, representative.flux, x, toCamera, medium);
+                ++leavesInCut;
+                continue;
+            }
+            const Rgb b = bound(i, x, medium);
+            if (!std::isfinite(b.x + b.y + b.z)) {  // x in the node's box: refine without estimating
+                --statistics.evaluated;
+                ++statistics.intersected;
+                pending.push_back(node.left);
+                pending.push_back(node.right);
+                continue;
+            }
+            const Rgb e = vplContribution(representative, node.clusterFlux, x, toCamera, medium);
+            ++statistics.boundedEstimates;
+            if (e.x > b.x || e.y > b.y || e.z > b.z) ++statistics.boundExceeded;
+            total += e;
+            const float key = luminance(b);
+            heap.push({key >= 0.0f ? key : std::numeric_limits<float>::infinity(), i, e});
+        }
+    };
+    addToCut(tree_.root());
+    while (!heap.empty()) {
+        const CutNode& top = heap.top();
+        if (top.bound <= settings_.errorThreshold * std::max(0.0f, luminance(total))) break;
+        if (heap.size() + leavesInCut >= settings_.maxCutSize) break;
+        const CutNode refined = top;
+        heap.pop();
+        total -= refined.estimate;
+        addToCut(nodes[refined.node].left);
+        addToCut(nodes[refined.node].right);
+    }
+    statistics.cutSize += uint32_t(heap.size()) + leavesInCut;
+    return Rgb(std::max(0.0f, total.x), std::max(0.0f, total.y), std::max(0.0f, total.z));
+}
+
+Rgb VplLightcutsEstimator::estimate(const CameraSegment& segment, Rng& rng, CutStatistics& statistics) const {
+    if (tree_.empty() || !(segment.length > 0.0f)) return Rgb(0.0f);
+    const HomogeneousMedium& medium = scene_.media()[segment.medium];
+    if (medium.isNonScattering()) return Rgb(0.0f);
+    // Density proportional to exp(-sigma u) on [0, length], sigma the smallest
+    // channel's extinction: every channel's T_r(u) / p(u) stays bounded.
+    const double sigma = minComponent(medium.sigmaT());
+    const double length = segment.length;
+    const bool uniform = !(sigma * length > 1e-6);
+    const double norm = uniform ? length : -std::expm1(-sigma * length) / sigma;  // integral of exp(-sigma u)
+    const Vec3 toCamera = -segment.direction;
+    Rgb sum(0.0f);
+    for (int i = 0; i < distanceSamples_; ++i) {
+        const double xi = (i + rng.nextDouble()) / distanceSamples_;
+        const double u = uniform ? xi * length
+                                 : std::min(length, -std::log1p(xi * std::expm1(-sigma * length)) / sigma);
+        const double pdf = (uniform ? 1.0 : std::exp(-sigma * u)) / norm;
+        if (!(pdf > 0.0) || !std::isfinite(pdf)) continue;
+        const Vec3 x = segment.origin + segment.direction * float(u);
+        const Rgb in = gather(x, toCamera, segment.medium, statistics);
+        sum += in * medium.transmittance(float(u)) * float(1.0 / (pdf * distanceSamples_));
+    }
+    return sum * medium.sigmaS() * segment.throughputBefore;
+}
+
+}  // namespace vrl
