@@ -24,7 +24,7 @@ void addRenderOptions(CLI::App& cmd, RenderCommandOptions& o) {
                     "(a)-(c) by path sampling, multiple scattering (d) by plain VRLs), vrl-lightcuts (the same, "
                     "(d) by cuts through a VRL light tree) or vpl-lightcuts (the paper's baseline: (d) by Lightcuts "
                     "over VPLs at the light paths' medium collisions, 32 stratified distance samples per camera "
-                    "segment, no clamping)")
+                    "segment, no clamping; vpl: the same with every VPL gathered, no tree)")
         ->check(CLI::IsMember(kRenderMethods));
     cmd.add_option("--spp", o.spp, "Samples per pixel (default: the scene's sampler sampleCount)")
         ->check(CLI::Range(1, kMaxSampleCount));

@@ -26,7 +26,7 @@ Ray cameraRay(const PerspectiveCamera& camera, const RenderSettings& settings, i
 }
 
 bool isVrlMethod(const RenderSettings& settings) {
-    return settings.method == "vrl" || usesLightTree(settings.method);
+    return settings.method == "vrl" || settings.method == "vpl" || usesLightTree(settings.method);
 }
 
 }  // namespace
@@ -55,7 +55,7 @@ RenderLights prepareLights(const Scene& scene, const RenderSettings& settings, c
     tracing.targetVrls = settings.vrlCount;
     tracing.maxDepth = settings.maxDepth;
     tracing.seed = settings.seed ^ 0x5bd1e995ULL;  // a stream family apart from the camera's
-    const bool points = settings.method == "vpl-lightcuts";
+    const bool points = usesVpls(settings.method);
     if (points) tracing.deposit = LightDeposit::Points;
     lights.vrls = traceVrls(scene, tracing, [&](double f) {
         if (progress) progress("light tracing", f);
@@ -104,7 +104,7 @@ TileShader::TileShader(const Scene& scene, const RenderSettings& settings, const
         const bool lightcuts = usesLightTree(settings.method);
         VrlIntegratorSettings integratorSettings{settings.transports, settings.maxDepth, settings.vrlSamples,
                                                  settings.cut};
-        integratorSettings.vplLightcuts = settings.method == "vpl-lightcuts";
+        integratorSettings.vpls = usesVpls(settings.method);
         integratorSettings.vplDistanceSamples = settings.vplDistanceSamples;
         integrator_ = std::make_unique<VrlIntegrator>(scene, lights.vrls, integratorSettings,
                                                       lightcuts && lights.tree.root() >= 0 ? &lights.tree : nullptr);

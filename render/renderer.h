@@ -24,9 +24,15 @@ namespace vrl {
 //   vrl:  the four transport parts, multiple scattering by plain VRLs; one layer per part
 //   vrl-lightcuts: the same, multiple scattering by cuts through a VRL light tree,
 //         plus per-pixel layers "eval", "inter" and "cut" (statistics)
-//   vpl-lightcuts: the same layers, multiple scattering by VPL Lightcuts (the
-//         paper's baseline, vpl_lightcuts.h); vrlCount is then the number of VPLs
-inline const std::vector<std::string> kRenderMethods = {"path", "vrl", "vrl-lightcuts", "vpl-lightcuts"};
+//   vpl:  the four parts, multiple scattering by plain VPLs (every VPL at each of
+//         the distance samples; the brute force VPL Lightcuts is measured against)
+//   vpl-lightcuts: the same layers as vrl-lightcuts, multiple scattering by VPL
+//         Lightcuts (the paper's baseline, vpl_lightcuts.h)
+// For vpl and vpl-lightcuts, vrlCount counts VPLs.
+inline const std::vector<std::string> kRenderMethods = {"path", "vrl", "vrl-lightcuts", "vpl", "vpl-lightcuts"};
+
+// The method deposits VPLs (points) rather than VRLs.
+inline bool usesVpls(const std::string& method) { return method == "vpl" || method == "vpl-lightcuts"; }
 
 // The method builds a light tree (VRL or VPL Lightcuts): it ships a tree, not a VRL set.
 inline bool usesLightTree(const std::string& method) { return method == "vrl-lightcuts" || method == "vpl-lightcuts"; }

@@ -34,6 +34,11 @@ VplLightcutsEstimator::VplLightcutsEstimator(const Scene& scene, const LightTree
 
 Rgb VplLightcutsEstimator::vplContribution(const Vrl& vpl, const Rgb& flux, const Vec3& x, const Vec3& toCamera,
                                            int medium) const {
+    return vrl::vplContribution(scene_, vpl, flux, x, toCamera, medium);
+}
+
+Rgb vplContribution(const Scene& scene_, const Vrl& vpl, const Rgb& flux, const Vec3& x, const Vec3& toCamera,
+                    int medium) {
     const Vec3 d = x - vpl.origin;
     const float w2 = d.length2();
     if (!(w2 > 0.0f) || !std::isfinite(w2)) return Rgb(0.0f);
@@ -128,29 +133,49 @@ Rgb VplLightcutsEstimator::gather(const Vec3& x, const Vec3& toCamera, int mediu
     return Rgb(std::max(0.0f, total.x), std::max(0.0f, total.y), std::max(0.0f, total.z));
 }
 
-Rgb VplLightcutsEstimator::estimate(const CameraSegment& segment, Rng& rng, CutStatistics& statistics) const {
-    if (tree_.empty() || !(segment.length > 0.0f)) return Rgb(0.0f);
-    const HomogeneousMedium& medium = scene_.media()[segment.medium];
+Rgb integrateAlongSegment(const Scene& scene, const CameraSegment& segment, int distanceSamples, Rng& rng,
+                          const std::function<Rgb(const Vec3& x)>& gather) {
+    if (!(segment.length > 0.0f) || distanceSamples < 1) return Rgb(0.0f);
+    const HomogeneousMedium& medium = scene.media()[segment.medium];
     if (medium.isNonScattering()) return Rgb(0.0f);
-    // Density proportional to exp(-sigma u) on [0, length], sigma the smallest
-    // channel's extinction: every channel's T_r(u) / p(u) stays bounded.
     const double sigma = minComponent(medium.sigmaT());
     const double length = segment.length;
     const bool uniform = !(sigma * length > 1e-6);
     const double norm = uniform ? length : -std::expm1(-sigma * length) / sigma;  // integral of exp(-sigma u)
-    const Vec3 toCamera = -segment.direction;
     Rgb sum(0.0f);
-    for (int i = 0; i < distanceSamples_; ++i) {
-        const double xi = (i + rng.nextDouble()) / distanceSamples_;
+    for (int i = 0; i < distanceSamples; ++i) {
+        const double xi = (i + rng.nextDouble()) / distanceSamples;
         const double u = uniform ? xi * length
                                  : std::min(length, -std::log1p(xi * std::expm1(-sigma * length)) / sigma);
         const double pdf = (uniform ? 1.0 : std::exp(-sigma * u)) / norm;
         if (!(pdf > 0.0) || !std::isfinite(pdf)) continue;
-        const Vec3 x = segment.origin + segment.direction * float(u);
-        const Rgb in = gather(x, toCamera, segment.medium, statistics);
-        sum += in * medium.transmittance(float(u)) * float(1.0 / (pdf * distanceSamples_));
+        const Rgb in = gather(segment.origin + segment.direction * float(u));
+        sum += in * medium.transmittance(float(u)) * float(1.0 / (pdf * distanceSamples));
     }
     return sum * medium.sigmaS() * segment.throughputBefore;
+}
+
+Rgb VplLightcutsEstimator::estimate(const CameraSegment& segment, Rng& rng, CutStatistics& statistics) const {
+    if (tree_.empty()) return Rgb(0.0f);
+    const Vec3 toCamera = -segment.direction;
+    return integrateAlongSegment(scene_, segment, distanceSamples_, rng, [&](const Vec3& x) {
+        return gather(x, toCamera, segment.medium, statistics);
+    });
+}
+
+VplEstimator::VplEstimator(const Scene& scene, const std::vector<Vrl>& vpls, int distanceSamples)
+    : scene_(scene), vpls_(vpls), distanceSamples_(distanceSamples) {
+    if (distanceSamples_ < 1) throw std::invalid_argument("VPLs need at least one distance sample");
+}
+
+Rgb VplEstimator::estimate(const CameraSegment& segment, Rng& rng) const {
+    if (vpls_.empty()) return Rgb(0.0f);
+    const Vec3 toCamera = -segment.direction;
+    return integrateAlongSegment(scene_, segment, distanceSamples_, rng, [&](const Vec3& x) {
+        Rgb total(0.0f);
+        for (const Vrl& vpl : vpls_) total += vplContribution(scene_, vpl, vpl.flux, x, toCamera, segment.medium);
+        return total;
+    });
 }
 
 }  // namespace vrl

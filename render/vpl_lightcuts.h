@@ -18,6 +18,9 @@
 #include "render/light_tree.h"
 #include "render/rng.h"
 
+#include <functional>
+#include <vector>
+
 namespace vrl {
 
 class Scene;
@@ -48,6 +51,32 @@ private:
     CutSettings settings_;
     int distanceSamples_;
 };
+
+// Plain VPLs (--method vpl): the same distance samples, each gathering every
+// VPL (no tree): the brute-force cost VPL Lightcuts is measured against.
+class VplEstimator {
+public:
+    VplEstimator(const Scene& scene, const std::vector<Vrl>& vpls,
+                 int distanceSamples = VplLightcutsEstimator::kDefaultDistanceSamples);
+    Rgb estimate(const CameraSegment& segment, Rng& rng) const;
+
+private:
+    const Scene& scene_;
+    const std::vector<Vrl>& vpls_;
+    int distanceSamples_;
+};
+
+// The shared distance sampling: `distanceSamples` stratified u on the segment
+// with density proportional to exp(-sigma u) (sigma: the smallest channel's
+// extinction, so every channel's T_r(u) / p(u) stays bounded), each weighted by
+// T_r(u) / (p(u) n) and multiplied by gather(x(u)); times sigma_s and throughputBefore.
+Rgb integrateAlongSegment(const Scene& scene, const CameraSegment& segment, int distanceSamples, Rng& rng,
+                          const std::function<Rgb(const Vec3& x)>& gather);
+
+// One VPL's term of Eq. 4 at x (medium `medium`, light leaving towards the camera
+// along `toCamera`): flux f(x_k) f(x) T_r(w) V / w^2; 0 at w = 0.
+Rgb vplContribution(const Scene& scene, const Vrl& vpl, const Rgb& flux, const Vec3& x, const Vec3& toCamera,
+                    int medium);
 
 // Distance from a point to a box (0 inside).
 double distancePointBox(const Vec3& point, const Imath::Box3f& box);

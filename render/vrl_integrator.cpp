@@ -14,8 +14,10 @@ VrlIntegrator::VrlIntegrator(const Scene& scene, const VrlSet& vrls, const VrlIn
       tracer_(scene, PathTracerSettings{settings.maxDepth}),
       estimator_(scene, settings.vrlSamples),
       tree_(tree) {
-    if (tree_ && settings.vplLightcuts)
+    if (settings.vpls && tree_)
         vplLightcuts_ = std::make_unique<VplLightcutsEstimator>(scene, *tree_, settings.cut, settings.vplDistanceSamples);
+    else if (settings.vpls)
+        plainVpls_ = std::make_unique<VplEstimator>(scene, vrls.vrls, settings.vplDistanceSamples);
     else if (tree_)
         lightcuts_ = std::make_unique<LightcutsEstimator>(scene, *tree_, estimator_, settings.cut);
     if (settings.maxDepth >= 0 && settings.maxDepth < 16 && scene.hasSpecularSurfaces() &&
@@ -100,9 +102,11 @@ Rgb VrlIntegrator::multipleScattering(const Ray& cameraRay, Rng& rng, CutStatist
     for (const CameraSegment& segment : cameraSegments(scene_, cameraRay, scene_.cameraMedium(), &rng, settings_.maxDepth)) {
         const uint64_t streamKey = Rng::combine(pixelKey, segmentIndex++);
         if (scene_.media()[segment.medium].isNonScattering()) continue;
-        if (vplLightcuts_) {
+        if (vplLightcuts_ || plainVpls_) {
+            // The same distance samples in both: they differ only by the cut.
             Rng segmentRng = vrlStream(streamKey, ~0u);
-            sum += vplLightcuts_->estimate(segment, segmentRng, statistics ? *statistics : unused);
+            sum += vplLightcuts_ ? vplLightcuts_->estimate(segment, segmentRng, statistics ? *statistics : unused)
+                                 : plainVpls_->estimate(segment, segmentRng);
         } else if (lightcuts_) {
             sum += lightcuts_->estimate(segment, streamKey, statistics ? *statistics : unused);
         } else {

@@ -6,7 +6,8 @@
 // direction by the phase function, and path-traces from the surface that
 // direction reaches (exact transmittance in between, no emission there: (b)
 // has it); (d) sums the VRL estimator over every VRL (plain VRLs, --method vrl),
-// walks Lightcuts over a VRL tree (vrl-lightcuts) or over a VPL tree (vpl-lightcuts).
+// walks Lightcuts over a VRL tree (vrl-lightcuts), or gathers VPLs at distance
+// samples, every one (vpl) or by Lightcuts over a VPL tree (vpl-lightcuts).
 // Each part is estimated for paths its siblings leave out, so the parts add up
 // to the reference path tracer's image. Camera paths continue through purely
 // specular surfaces (camera_segment.h): parts (b)-(d) shade every medium
@@ -33,9 +34,9 @@ struct VrlIntegratorSettings {
     int maxDepth = -1;
     int vrlSamples = 1;  // (u, v) samples per VRL and camera segment
     CutSettings cut;     // used when a light tree is given
-    // With a tree: it holds VPLs and (d) is VPL Lightcuts (vpl_lightcuts.h).
-    bool vplLightcuts = false;
-    int vplDistanceSamples = 32;  // distance samples per camera segment (VPL Lightcuts)
+    // The lights are VPLs: (d) is VPL Lightcuts over the tree, or plain VPLs without one.
+    bool vpls = false;
+    int vplDistanceSamples = 32;  // distance samples per camera segment (VPLs)
 };
 
 class VrlIntegrator {
@@ -61,6 +62,7 @@ private:
     const LightTree* tree_;
     std::unique_ptr<LightcutsEstimator> lightcuts_;
     std::unique_ptr<VplLightcutsEstimator> vplLightcuts_;
+    std::unique_ptr<VplEstimator> plainVpls_;
 };
 
 }  // namespace vrl
