@@ -135,7 +135,15 @@ VrlSet traceVrls(const Scene& scene, const LightTracingSettings& settings,
     uint64_t emptyBatches = 0;
     while (true) {
         const uint64_t remaining = settings.lightPaths > 0 ? settings.lightPaths - result.lightPaths : ~0ULL;
-        const uint64_t batch = std::min(remaining, kPathsPerChunk * kChunksPerBatch);
+        uint64_t batch = std::min(remaining, kPathsPerChunk * kChunksPerBatch);
+        if (settings.lightPaths == 0) {
+            // Aim at the target: a first batch of about target / 8 paths, then as many
+            // paths as the deposits per path so far say are missing (at least one per
+            // chunk), so small targets are not overshot by a whole batch.
+            const double have = double(result.vrls.size()), perPath = result.lightPaths ? have / double(result.lightPaths) : 8.0;
+            const double wanted = std::ceil((double(settings.targetVrls) - have) / std::max(perPath, 1e-3));
+            batch = uint64_t(std::clamp(wanted, double(kChunksPerBatch), double(batch)));
+        }
         if (batch == 0) break;
         const uint64_t first = result.lightPaths;
         tbb::parallel_for(uint64_t(0), kChunksPerBatch, [&](uint64_t c) {

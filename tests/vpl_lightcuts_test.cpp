@@ -44,7 +44,7 @@ Vec3 uniformIn(Rng& rng, float halfSize) {
 }
 
 Vec3 uniformDirection(Rng& rng) {
-    const float z = 1.0f - 2.0f * rng.next(), phi = 2.0f * float(M_PI) * rng.next();
+    const float z = 1.0f - 2.0f * rng.next(), phi = 6.28318530718f * rng.next();
     const float r = std::sqrt(std::max(0.0f, 1.0f - z * z));
     return Vec3(r * std::cos(phi), r * std::sin(phi), z);
 }
@@ -258,7 +258,7 @@ TEST(VplLightcuts, ZeroThresholdGatherIsBruteForceSum) {
 void expectConservativeBound(const Scene& scene, const char* name) {
     ASSERT_TRUE(scene.media()[0].boundaryConvex());
     ASSERT_TRUE(scene.media()[0].phase().isIsotropic());
-    const VrlSet set = tracePoints(scene, 3000, 21);
+    const VrlSet set = tracePoints(scene, 4000, 21);
     ASSERT_GT(set.vrls.size(), 5000u) << name;
     const LightTree tree = LightTree::build(set.vrls, LightTreeSettings{512, 21, true});
     const VplLightcutsEstimator estimator(scene, tree, CutSettings{});
@@ -293,6 +293,7 @@ void expectConservativeBound(const Scene& scene, const char* name) {
     }
     std::vector<Rgb> maxBelow(nodes.size());
     size_t checked = 0, infinite = 0;
+    double tightest = std::numeric_limits<double>::infinity();  // least bound / largest VPL term
     for (size_t k = 0; k < points.size(); ++k) {
         const Vec3& x = points[k];
         const Vec3 toCamera = uniformDirection(rng);
@@ -316,14 +317,16 @@ void expectConservativeBound(const Scene& scene, const char* name) {
             for (int c = 0; c < 3; ++c) {
                 ASSERT_GE(b[c], e[c]) << name << ": representative of node " << i << " at point " << k << " channel " << c;
                 ASSERT_GE(b[c], maxBelow[i][c]) << name << ": a VPL of node " << i << " at point " << k << " channel " << c;
+                if (maxBelow[i][c] > 0.0f) tightest = std::min(tightest, double(b[c]) / maxBelow[i][c]);
             }
             ++checked;
         }
-        // Inside every inner node's box (its centre): infinite.
     }
+    // Inside every inner node's box (its centre): infinite.
     for (size_t i = n; i < nodes.size(); ++i)
         ASSERT_TRUE(allInfinite(estimator.bound(int32_t(i), nodes[i].box.center(), medium))) << name << " node " << i;
-    std::printf("%s: %zu finite bounds checked, %zu infinite\n", name, checked, infinite);
+    std::printf("%s: %zu finite bounds checked, %zu infinite, least bound / largest VPL term %.6f\n", name, checked,
+                infinite, tightest);
     EXPECT_GT(checked, 10 * (nodes.size() - n)) << "most (point, node) pairs have a finite bound";
 }
 
@@ -363,13 +366,17 @@ double meanLuminance(const Image& image) {
 // whose stretches are the VRLs), so their per-seed difference D is a low-variance
 // paired statistic. Over K = 8 seeds, mean(D) must lie within 5 standard errors
 // (Student t, 7 dof: P(|t| > 5) ~ 0.0016) plus 2% of the mean for the bias of the
-// cut at the default error threshold 0.02 (a refined node's error is at most
-// 2% of the gather; measured here it is well below that). Power: the standard
-// error of D must be under 3% of the mean, so e.g. a missing phase factor or
-// sigma_s would fail.
+// cut at the default error threshold 0.02 (a node is left unrefined only while
+// its bound is below 2% of the gather; over 64 seeds the threshold-0.02 and
+// threshold-0 renders of these scenes differed by under 0.5% of the mean, and
+// both agreed with plain VRLs within 1 standard error). The VPL gather keeps the
+// 1/w^2 singularity, so D is heavy-tailed; the t statistic stays robust to a
+// single outlier run, which inflates the standard error as much as the mean.
+// Power: the standard error of D must be under 3% of the mean (about 0.9% with
+// these seeds), so a missing phase, sigma_s or sigma_s / majorant factor fails.
 TEST(VplLightcuts, MultipleScatteringMatchesPlainVrls) {
     for (const MediumCase& m : {kGrey, kChromatic}) {
-        const auto scene = Scene::build(smallCube(m, 8));
+        const auto scene = Scene::build(smallCube(m, 6));
         constexpr int kRuns = 8;
         double sumD = 0, sumD2 = 0, sumVrl = 0;
         for (int r = 0; r < kRuns; ++r) {

@@ -1,0 +1,102 @@
+#include "bench/report/benchmark_scenes.h"
+
+#include <cstdio>
+
+namespace vrl::report {
+
+namespace {
+
+std::string compactCount(uint64_t n) {
+    char buffer[32];
+    if (n >= 1000000 && n % 1000000 == 0) std::snprintf(buffer, sizeof buffer, "%lluM", (unsigned long long)(n / 1000000));
+    else if (n >= 1000 && n % 1000 == 0) std::snprintf(buffer, sizeof buffer, "%lluk", (unsigned long long)(n / 1000));
+    else std::snprintf(buffer, sizeof buffer, "%llu", (unsigned long long)n);
+    return buffer;
+}
+
+// The sweep every scene gets, scaled by `scale` (1 for the full report).
+std::vector<MethodRun> sweep(bool quick, int sppVirtual) {
+    std::vector<MethodRun> runs;
+    if (quick) {
+        runs.push_back({"path", 0, 4});
+        runs.push_back({"path", 0, 16});
+        runs.push_back({"vrl", 1000, sppVirtual});
+        runs.push_back({"vrl", 3000, sppVirtual});
+        runs.push_back({"vrl-lightcuts", 3000, sppVirtual, 0.02f});
+        runs.push_back({"vrl-lightcuts", 10000, sppVirtual, 0.02f});
+        runs.push_back({"vpl-lightcuts", 3000, sppVirtual, 0.02f});
+        runs.push_back({"vpl-lightcuts", 10000, sppVirtual, 0.02f});
+        return runs;
+    }
+    for (int spp : {4, 16, 64, 256}) runs.push_back({"path", 0, spp});
+    for (uint64_t n : {1000ULL, 4000ULL, 16000ULL}) runs.push_back({"vrl", n, sppVirtual});
+    for (uint64_t n : {10000ULL, 100000ULL, 1000000ULL}) runs.push_back({"vrl-lightcuts", n, sppVirtual, 0.02f});
+    for (uint64_t n : {10000ULL, 100000ULL}) runs.push_back({"vrl-lightcuts", n, sppVirtual, 0.1f});
+    for (uint64_t n : {10000ULL, 100000ULL, 1000000ULL}) runs.push_back({"vpl-lightcuts", n, sppVirtual, 0.02f});
+    return runs;
+}
+
+}  // namespace
+
+std::string MethodRun::label() const {
+    char buffer[96];
+    if (method == "path") {
+        std::snprintf(buffer, sizeof buffer, "%d spp", spp);
+    } else if (method == "vrl" || method == "vpl") {
+        std::snprintf(buffer, sizeof buffer, "N=%s, %d spp", compactCount(lights).c_str(), spp);
+    } else {
+        std::snprintf(buffer, sizeof buffer, "N=%s, e=%g, %d spp", compactCount(lights).c_str(), double(errorThreshold), spp);
+    }
+    return buffer;
+}
+
+std::vector<BenchmarkScene> benchmarkScenes(bool quick, const std::filesystem::path& repository,
+                                            const std::filesystem::path& shared) {
+    std::vector<BenchmarkScene> scenes;
+    const auto own = [&](std::string name, std::string description, std::map<std::string, std::string> defines) {
+        BenchmarkScene s;
+        s.name = std::move(name);
+        s.description = std::move(description);
+        s.file = repository / "scenes" / "bathroom-spots.xml";
+        s.defines = std::move(defines);
+        if (quick) {
+            s.width = 32, s.height = 24, s.referenceSpp = 256;
+            s.tableLights = 10000;
+            s.speedupLights = {1000, 10000};
+        } else {
+            s.width = 96, s.height = 72, s.referenceSpp = 4096;
+            s.tableLights = 100000;
+            s.speedupLights = {1000, 10000, 100000, 1000000};
+        }
+        s.runs = sweep(quick, 4);
+        return s;
+    };
+    scenes.push_back(own("bathroom", "our own scene in the spirit of the paper's BATHROOM: two spot lights in an "
+                                     "isotropic smoke, shining partly toward the camera", {}));
+    if (quick) return scenes;
+    scenes.push_back(own("bathroom-hg07", "the same with Henyey-Greenstein g = 0.7 (forward scattering)", {{"g", "0.7"}}));
+
+    const auto paper = [&](std::string name, std::string description, std::filesystem::path file, std::string medium,
+                           int width, int height, int referenceSpp) {
+        BenchmarkScene s;
+        s.name = std::move(name);
+        s.description = std::move(description);
+        s.file = shared / file;
+        s.shared = true;
+        s.medium = std::move(medium);
+        s.width = width, s.height = height, s.referenceSpp = referenceSpp;
+        s.runs = sweep(false, 4);
+        s.tableLights = 100000;
+        s.speedupLights = {1000, 10000, 100000, 1000000};
+        return s;
+    };
+    scenes.push_back(paper("staircase", "the paper's STAIRCASE: one area light at the top, filled with dense smoke",
+                           "staircase/scene.xml", "sigmaS=0.1,sigmaA=0.02", 54, 96, 4096));
+    scenes.push_back(paper("veach-lamp", "the paper's VEACH-LAMP: lamps with shades, filled with smoke",
+                           "veach-lamp-mitsuba-bidir/scene.xml", "sigmaS=0.2,sigmaA=0.04", 96, 54, 4096));
+    scenes.push_back(paper("volumetric-caustic", "Bitterli's volumetric caustic as it is (smoke-filled box, glass sphere)",
+                           "volumetric-caustic/scene_v0.6.xml", "", 64, 64, 4096));
+    return scenes;
+}
+
+}  // namespace vrl::report

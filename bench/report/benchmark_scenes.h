@@ -1,0 +1,44 @@
+// The benchmark scenes of the error-against-time report and the settings each
+// method is run with (full and --quick). Paths to the paper's scenes are
+// relative to the shared scene folder; our own are in the repository.
+#pragma once
+
+#include <cstdint>
+#include <filesystem>
+#include <map>
+#include <string>
+#include <vector>
+
+namespace vrl::report {
+
+// One render of the sweep. `lights`: VRLs or VPLs (0 for the path tracer);
+// `spp`: samples per pixel (path tracer; parts (a)-(c) of the virtual-light methods).
+struct MethodRun {
+    std::string method;
+    uint64_t lights = 0;
+    int spp = 1;
+    float errorThreshold = 0.02f;
+    std::string label() const;
+};
+
+struct BenchmarkScene {
+    std::string name;
+    std::string description;
+    std::filesystem::path file;     // absolute, or relative to the shared scenes / the repository
+    bool shared = false;            // from ../shared/scenes (skipped with a reason when absent)
+    std::map<std::string, std::string> defines;
+    std::string medium;             // --medium fill, or empty
+    int width = 64, height = 48;
+    int maxDepth = 12;              // the paper's "maximum path length is 12 for all the scenes"
+    int referenceSpp = 256;         // path tracer; two independent halves of referenceSpp / 2
+    std::vector<MethodRun> runs;
+    uint64_t tableLights = 100000;  // N of the Table 1 / Figure 6 runs (both Lightcuts at the default threshold)
+    std::vector<uint64_t> speedupLights;  // N of the Figure 4 speed-up measurement
+};
+
+// The scene list. `repository`: the source tree (for scenes/); `shared`: the
+// shared scene folder (may not exist).
+std::vector<BenchmarkScene> benchmarkScenes(bool quick, const std::filesystem::path& repository,
+                                            const std::filesystem::path& shared);
+
+}  // namespace vrl::report

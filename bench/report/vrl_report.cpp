@@ -1,0 +1,553 @@
+// vrl_report: error against run time for every method on the benchmark scenes
+// (Vibert et al. 2019, Figures 3, 4, 6 and Table 1). For each scene: a
+// path-traced reference (two independent halves, cached by a hash of the
+// scene's files and the settings; their difference estimates its noise), then
+// every method over a range of settings, recording wall time (light tracing,
+// tree build and shading; the scene load is common to all and left out),
+// RMSE, relative RMSE, SMAPE and the cut statistics. Writes results.csv,
+// speedup.csv, false-colour #Eval / #Inter images, previews, summary.md and
+// (through bench/plot_report.py) the plots.
+#include "bench/report/benchmark_scenes.h"
+#include "bench/report/curve_ratios.h"
+#include "bench/report/false_colour.h"
+#include "proto/rpc_common.h"
+
+#include "render/exr_io.h"
+#include "render/image_metrics.h"
+#include "render/light_tracer.h"
+#include "render/medium_fill.h"
+#include "render/mitsuba_parser.h"
+#include "render/preview_image.h"
+#include "render/renderer.h"
+#include "render/scene.h"
+#include "render/timing.h"
+
+#include <CLI/CLI.hpp>
+#include <spdlog/spdlog.h>
+#include <tbb/info.h>
+#include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <ctime>
+#include <fstream>
+#include <iomanip>
+#include <map>
+#include <sstream>
+
+namespace fs = std::filesystem;
+using namespace vrl;
+using namespace vrl::report;
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+struct Options {
+    fs::path out = "report";
+    fs::path shared = fs::path(VRL_SOURCE_DIR).parent_path() / "shared" / "scenes";
+    bool quick = false;
+    std::vector<std::string> only;
+    int threads = 0;
+    std::string python = "/usr/bin/python3";
+    bool plots = true;
+};
+
+struct RunResult {
+    std::string scene;
+    MethodRun run;
+    double seconds = 0.0;
+    ImageErrorMetrics metrics;
+    RenderStatistics stats;
+};
+
+struct SpeedupResult {
+    std::string scene, kind;
+    uint64_t lights = 0;
+    double bruteSecondsPerPixel = 0.0, lightcutsSecondsPerPixel = 0.0;
+    double meanEval = 0.0, meanInter = 0.0;
+};
+
+struct ReferenceInfo {
+    int spp = 0;
+    double seconds = 0.0;  // when rendered in this run or recorded in the cache
+    bool cached = false;
+    double noiseRmse = 0.0, noiseRelativeRmse = 0.0, noiseSmape = 0.0;
+    fs::path file;
+};
+
+// Progress lines with the elapsed time of the whole report.
+class Log {
+public:
+    explicit Log(Clock::time_point start) : start_(start) {}
+    template <class... Args>
+    void line(const char* format, Args... args) const {
+        const double t = secondsSince(start_);
+        std::fprintf(stderr, "[%3d:%02d] ", int(t) / 60, int(t) % 60);
+        std::fprintf(stderr, format, args...);
+        std::fputc('\n', stderr);
+    }
+
+private:
+    Clock::time_point start_;
+};
+
+std::string hashSceneAndSettings(const BenchmarkScene& s, const std::string& settings) {
+    ParseOptions options;
+    options.defines = s.defines;
+    std::vector<fs::path> files{s.file};
+    options.onFileReferenced = [&](const fs::path& f) { files.push_back(f); };
+    (void)parseMitsubaScene(s.file, options);
+    std::string all = settings;
+    for (const auto& f : files) {
+        std::ifstream in(f, std::ios::binary);
+        std::ostringstream bytes;
+        bytes << in.rdbuf();
+        all += "\n" + f.filename().string() + ":" + rpc::sha256Hex(bytes.str());
+    }
+    return rpc::sha256Hex(all).substr(0, 16);
+}
+
+std::unique_ptr<Scene> loadScene(const BenchmarkScene& s) {
+    ParseOptions options;
+    options.defines = s.defines;
+    SceneDescription description = parseMitsubaScene(s.file, options);
+    if (!s.medium.empty()) fillWithMedium(description, parseFillMedium(s.medium));
+    description.sensor.width = s.width;
+    description.sensor.height = s.height;
+    return Scene::build(description);
+}
+
+RenderSettings settingsFor(const BenchmarkScene& s, const MethodRun& run, uint64_t seed) {
+    RenderSettings settings;
+    settings.method = run.method;
+    settings.samplesPerPixel = run.spp;
+    settings.seed = seed;
+    settings.maxDepth = s.maxDepth;
+    settings.vrlCount = std::max<uint64_t>(1, run.lights);
+    settings.cut.errorThreshold = run.errorThreshold;
+    return settings;
+}
+
+// Renders (or loads) the reference: the mean of two independent path-traced halves.
+Image referenceImage(const BenchmarkScene& s, const Scene& scene, const fs::path& cacheDir, const Log& log,
+                     ReferenceInfo& info) {
+    const int half = std::max(1, s.referenceSpp / 2);
+    const std::string key = "path spp=" + std::to_string(half) + "x2 maxDepth=" + std::to_string(s.maxDepth) +
+                            " size=" + std::to_string(s.width) + "x" + std::to_string(s.height) + " medium=" + s.medium +
+                            " version=" + VRL_VERSION;
+    const fs::path file = cacheDir / (s.name + "-reference-" + hashSceneAndSettings(s, key) + ".exr");
+    info.spp = 2 * half;
+    info.file = file;
+    ImageSet set;
+    if (fs::exists(file)) {
+        set = readExr(file);
+        info.cached = true;
+        info.seconds = std::atof(set.metadata["vrl.report.seconds"].c_str());
+        log.line("%s: reference from the cache (%s)", s.name.c_str(), file.filename().c_str());
+    } else {
+        log.line("%s: rendering the reference, path tracer %d spp in two halves (%dx%d)...", s.name.c_str(), 2 * half,
+                 s.width, s.height);
+        const auto start = Clock::now();
+        std::vector<Image> halves;
+        for (uint64_t h = 0; h < 2; ++h) {
+            MethodRun run{"path", 0, half};
+            int lastDecile = -1;
+            halves.push_back(render(scene, settingsFor(s, run, 1000003 + h), [&](const char*, double f) {
+                const int decile = int(f * 10.0);
+                if (decile > lastDecile && decile % 2 == 0) {
+                    lastDecile = decile;
+                    log.line("%s: reference half %d: %d%%", s.name.c_str(), int(h) + 1, decile * 10);
+                }
+            }).image);
+        }
+        info.seconds = secondsSince(start);
+        Image mean(s.width, s.height);
+        for (size_t i = 0; i < mean.pixelCount(); ++i) mean[i] = (halves[0][i] + halves[1][i]) * 0.5f;
+        set.image = mean;
+        set.layers = {{"half1", halves[0]}, {"half2", halves[1]}};
+        set.metadata["vrl.report.key"] = key;
+        set.metadata["vrl.report.seconds"] = std::to_string(info.seconds);
+        fs::create_directories(cacheDir);
+        writeExr(file, set);
+        log.line("%s: reference done in %.1f s -> %s", s.name.c_str(), info.seconds, file.string().c_str());
+    }
+    const Image* h1 = nullptr;
+    const Image* h2 = nullptr;
+    for (const auto& [name, image] : set.layers) {
+        if (name == "half1") h1 = &image;
+        if (name == "half2") h2 = &image;
+    }
+    if (!h1 || !h2) throw std::runtime_error("cached reference " + file.string() + " lacks its halves; delete it");
+    // The mean of two halves has half the variance of one: its RMSE against the
+    // truth is about RMSE(half1, half2) / 2 (independent, equal variance).
+    const ImageErrorMetrics m = compareImages(*h1, *h2);
+    info.noiseRmse = m.rmse / 2.0;
+    info.noiseRelativeRmse = m.relativeRmse / 2.0;
+    info.noiseSmape = m.smape / 2.0;  // SMAPE is not a variance; halving is only indicative
+    return set.image;
+}
+
+// Figure 4: seconds per pixel of brute force (plain VRLs / VPLs) and of
+// Lightcuts, multiple scattering (d) only, on a fixed spread of pixels.
+std::vector<SpeedupResult> measureSpeedup(const BenchmarkScene& s, const Scene& scene, const Log& log) {
+    std::vector<SpeedupResult> results;
+    for (const bool points : {false, true}) {
+        for (const uint64_t n : s.speedupLights) {
+            RenderSettings plain = settingsFor(s, MethodRun{points ? "vpl" : "vrl", n, 1}, 7);
+            plain.transports = TransportSelection::parse("multiple");
+            RenderSettings cuts = plain;
+            cuts.method = points ? "vpl-lightcuts" : "vrl-lightcuts";
+            RenderLights plainLights = prepareLights(scene, plain);
+            RenderLights cutLights;
+            cutLights.tree = LightTree::build(plainLights.vrls.vrls, LightTreeSettings{cuts.partitionSize, cuts.seed, points});
+            // Brute force costs N (VRLs) or 32 N (VPLs) terms per pixel: keep it to ~3e7 terms.
+            const double terms = double(plainLights.vrls.vrls.size()) * (points ? 32.0 : 1.0);
+            const int pixels = int(std::clamp(3e7 / std::max(1.0, terms), 8.0, 2048.0));
+            std::vector<TileRect> tiles;
+            const int total = s.width * s.height;
+            for (int k = 0; k < pixels; ++k) {
+                const long long index = (long long)k * total / pixels;
+                const int x = int(index % s.width), y = int(index / s.width);
+                tiles.push_back({x, y, x + 1, y + 1});
+            }
+            const auto timeShader = [&](const TileShader& shader, double minimumSeconds, double* eval, double* inter) {
+                int repeats = 0;
+                double evalSum = 0.0, interSum = 0.0;
+                const auto start = Clock::now();
+                do {
+                    std::vector<TileImages> out(tiles.size());
+                    tbb::parallel_for(size_t(0), tiles.size(), [&](size_t t) { out[t] = shader.renderTile(tiles[t]); });
+                    ++repeats;
+                    if (eval && out[0].layers.size() >= 4) {
+                        const size_t layers = out[0].layers.size();
+                        for (const auto& o : out) evalSum += o.layers[layers - 3][0].x, interSum += o.layers[layers - 2][0].x;
+                    }
+                } while (secondsSince(start) < minimumSeconds);
+                if (eval) *eval = evalSum / double(repeats * tiles.size());
+                if (inter) *inter = interSum / double(repeats * tiles.size());
+                return secondsSince(start) / double(repeats * tiles.size());
+            };
+            SpeedupResult r;
+            r.scene = s.name;
+            r.kind = points ? "VPL" : "VRL";
+            r.lights = plainLights.vrls.vrls.size();
+            r.bruteSecondsPerPixel = timeShader(TileShader(scene, plain, plainLights), 0.0, nullptr, nullptr);
+            r.lightcutsSecondsPerPixel = timeShader(TileShader(scene, cuts, cutLights), 0.5, &r.meanEval, &r.meanInter);
+            log.line("%s: speed-up %s N=%llu: brute %.3g s/pixel, Lightcuts %.3g s/pixel -> %.1fx (%d pixels)",
+                     s.name.c_str(), r.kind.c_str(), (unsigned long long)r.lights, r.bruteSecondsPerPixel,
+                     r.lightcutsSecondsPerPixel, r.bruteSecondsPerPixel / r.lightcutsSecondsPerPixel, pixels);
+            results.push_back(r);
+        }
+    }
+    return results;
+}
+
+const Image* layerOf(const ImageSet& set, const std::string& name) {
+    for (const auto& [n, image] : set.layers)
+        if (n == name) return &image;
+    return nullptr;
+}
+
+std::string fmt(double v, int precision = 3) {
+    if (!std::isfinite(v)) return "—";
+    std::ostringstream s;
+    s << std::setprecision(precision) << v;
+    return s.str();
+}
+
+std::string safeName(std::string s) {
+    for (char& c : s)
+        if (!std::isalnum((unsigned char)c) && c != '-' && c != '_') c = '_';
+    return s;
+}
+
+const char* methodTitle(const std::string& m) {
+    if (m == "path") return "path tracing";
+    if (m == "vrl") return "plain VRLs";
+    if (m == "vrl-lightcuts") return "VRL Lightcuts";
+    if (m == "vpl-lightcuts") return "VPL Lightcuts";
+    if (m == "vpl") return "plain VPLs";
+    return m.c_str();
+}
+
+// A method's curve at the default threshold (or all its runs for path / vrl).
+std::vector<CurvePoint> curveOf(const std::vector<RunResult>& results, const std::string& scene,
+                                const std::string& method, bool smape) {
+    std::vector<CurvePoint> points;
+    for (const auto& r : results) {
+        if (r.scene != scene || r.run.method != method) continue;
+        if (usesLightTree(method) && r.run.errorThreshold != 0.02f) continue;
+        points.push_back({r.seconds, smape ? r.metrics.smape : r.metrics.rmse});
+    }
+    return cleanCurve(points);
+}
+
+struct SceneReport {
+    BenchmarkScene scene;
+    ReferenceInfo reference;
+    double loadSeconds = 0.0;
+    std::string skipped;  // reason, if skipped
+    std::map<std::string, std::pair<double, double>> tableStats;  // method -> (#Eval, #Inter)
+    std::vector<std::string> images;  // markdown image lines
+};
+
+void writeSummary(const fs::path& path, const Options& o, const std::vector<SceneReport>& scenes,
+                  const std::vector<RunResult>& results, const std::vector<SpeedupResult>& speedups,
+                  double totalSeconds, int threads) {
+    std::ofstream md(path);
+    const std::time_t now = std::time(nullptr);
+    char date[64];
+    std::strftime(date, sizeof date, "%Y-%m-%d %H:%M UTC", std::gmtime(&now));
+    md << "# Error against run time: VRL Lightcuts, plain VRLs, VPL Lightcuts and path tracing\n\n";
+    md << "Generated by `build/bench/vrl_report" << (o.quick ? " --quick" : "") << "` on " << date << " with " << threads
+       << " threads, vrlcuts " << VRL_VERSION << "; the whole report took " << fmt(totalSeconds / 60.0, 3)
+       << " minutes. Data: `results.csv`, `speedup.csv`.\n\n";
+    md << "Every image is compared with a path-traced reference (two independent halves; the noise columns are the "
+          "reference's own estimated error, RMSE(half1, half2) / 2, below which no method can be measured). "
+          "Times are wall-clock seconds of light tracing, tree build and shading; the scene load is common to all "
+          "methods and left out. Virtual-light methods render parts (a)-(c) by path sampling at the stated spp and "
+          "multiple scattering (d) with their lights; Lightcuts at relative error threshold e (0.02 unless stated); "
+          "VPL Lightcuts gathers at 32 stratified distance samples per camera segment without clamping, as in the "
+          "paper. Errors are on luminance; SMAPE uses epsilon 0.01. Rays pass through pixel centres; maximum path "
+          "length 12.\n\n";
+    md << "## Scenes\n\n| scene | description | resolution | reference (path tracer) | reference noise RMSE / rel. RMSE / SMAPE |\n|---|---|---|---|---|\n";
+    for (const auto& s : scenes) {
+        if (!s.skipped.empty()) {
+            md << "| " << s.scene.name << " | " << s.scene.description << " | skipped: " << s.skipped << " | | |\n";
+            continue;
+        }
+        md << "| " << s.scene.name << " | " << s.scene.description << (s.scene.medium.empty() ? "" : " (`--medium " + s.scene.medium + "`)")
+           << " | " << s.scene.width << "x" << s.scene.height << " | " << s.reference.spp << " spp, "
+           << fmt(s.reference.seconds, 4) << " s" << (s.reference.cached ? " (cached)" : "") << " | "
+           << fmt(s.reference.noiseRmse) << " / " << fmt(s.reference.noiseRelativeRmse) << " / "
+           << fmt(s.reference.noiseSmape) << " |\n";
+    }
+    md << "\n";
+    const std::vector<std::string> others = {"vrl", "vpl-lightcuts", "path"};
+    for (const auto& s : scenes) {
+        if (!s.skipped.empty()) continue;
+        const std::string& name = s.scene.name;
+        md << "## " << name << "\n\n![error against time](error-time-" << safeName(name) << ".png)\n\n";
+        md << "| method | settings | time (s) | RMSE | rel. RMSE | SMAPE | mean ratio | #Eval | #Inter |\n|---|---|---|---|---|---|---|---|---|\n";
+        for (const auto& r : results) {
+            if (r.scene != name) continue;
+            const bool cuts = usesLightTree(r.run.method);
+            md << "| " << methodTitle(r.run.method) << " | " << r.run.label() << " | " << fmt(r.seconds) << " | "
+               << fmt(r.metrics.rmse) << " | " << fmt(r.metrics.relativeRmse) << " | " << fmt(r.metrics.smape) << " | "
+               << fmt(r.metrics.meanReference > 0 ? r.metrics.meanTest / r.metrics.meanReference : NAN) << " | "
+               << (cuts ? fmt(r.stats.meanEvaluated, 4) : "") << " | " << (cuts ? fmt(r.stats.meanIntersected, 4) : "")
+               << " |\n";
+        }
+        md << "\nEqual-time error ratios (the other method's error at VRL Lightcuts' time, divided by VRL Lightcuts' "
+              "error; > 1: VRL Lightcuts is better) and equal-error time ratios (the other method's time to reach VRL "
+              "Lightcuts' RMSE, divided by VRL Lightcuts' time; > 1: VRL Lightcuts is faster); '—' where the other "
+              "method's measured range does not reach.\n\n";
+        md << "| VRL Lightcuts point | time (s) |";
+        for (const auto& m : others) md << " " << methodTitle(m) << ": RMSE × | SMAPE × | time × |";
+        md << "\n|---|---|";
+        for (size_t k = 0; k < others.size(); ++k) md << "---|---|---|";
+        md << "\n";
+        for (const auto& r : results) {
+            if (r.scene != name || r.run.method != "vrl-lightcuts" || r.run.errorThreshold != 0.02f) continue;
+            md << "| " << r.run.label() << " | " << fmt(r.seconds) << " |";
+            for (const auto& m : others) {
+                const auto rmseCurve = curveOf(results, name, m, false), smapeCurve = curveOf(results, name, m, true);
+                const auto e1 = errorAtTime(rmseCurve, r.seconds), e2 = errorAtTime(smapeCurve, r.seconds);
+                const auto t = timeToError(rmseCurve, r.metrics.rmse);
+                md << " " << (e1 ? fmt(*e1 / r.metrics.rmse) : "—") << " | " << (e2 ? fmt(*e2 / r.metrics.smape) : "—")
+                   << " | " << (t ? fmt(*t / r.seconds) : "—") << " |";
+            }
+            md << "\n";
+        }
+        md << "\n";
+        for (const auto& line : s.images) md << line << "\n";
+        md << "\n";
+    }
+    md << "## Table 1: mean #Eval and #Inter per pixel (default threshold, the N stated)\n\n";
+    md << "| scene | N | VPL Lightcuts #Eval | #Inter | VRL Lightcuts #Eval | #Inter |\n|---|---|---|---|---|---|\n";
+    for (const auto& s : scenes) {
+        if (!s.skipped.empty()) continue;
+        const auto get = [&](const char* m) {
+            const auto it = s.tableStats.find(m);
+            return it == s.tableStats.end() ? std::pair<double, double>(NAN, NAN) : it->second;
+        };
+        const auto vpl = get("vpl-lightcuts"), vrlc = get("vrl-lightcuts");
+        md << "| " << s.scene.name << " | " << s.scene.tableLights << " | " << fmt(vpl.first, 4) << " | "
+           << fmt(vpl.second, 4) << " | " << fmt(vrlc.first, 4) << " | " << fmt(vrlc.second, 4) << " |\n";
+    }
+    md << "\nVPL counts are summed over the 32 distance samples of each camera segment (one cut each); VRL counts "
+          "are one cut per camera segment.\n\n";
+    md << "## Figure 4: speed-up of Lightcuts over brute force\n\n![speed-up](speedup.png)\n\n";
+    md << "Multiple scattering (d) only, seconds per pixel on a fixed spread of pixels (brute force: plain VRLs, or "
+          "every VPL at each distance sample).\n\n| scene | lights | N | brute force (ms/pixel) | Lightcuts (ms/pixel) | speed-up | #Eval | #Inter |\n|---|---|---|---|---|---|---|---|\n";
+    for (const auto& r : speedups)
+        md << "| " << r.scene << " | " << r.kind << " | " << r.lights << " | " << fmt(1e3 * r.bruteSecondsPerPixel)
+           << " | " << fmt(1e3 * r.lightcutsSecondsPerPixel) << " | "
+           << fmt(r.bruteSecondsPerPixel / r.lightcutsSecondsPerPixel) << " | " << fmt(r.meanEval, 4) << " | "
+           << fmt(r.meanInter, 4) << " |\n";
+}
+
+int runReport(const Options& o) {
+    const auto start = Clock::now();
+    const Log log(start);
+    const int threads = o.threads > 0 ? o.threads : tbb::info::default_concurrency();
+    tbb::task_arena arena(threads);
+    fs::create_directories(o.out / "images");
+    std::vector<BenchmarkScene> list = benchmarkScenes(o.quick, VRL_SOURCE_DIR, o.shared);
+    if (!o.only.empty()) {
+        std::erase_if(list, [&](const BenchmarkScene& s) { return std::find(o.only.begin(), o.only.end(), s.name) == o.only.end(); });
+        if (list.empty()) throw std::invalid_argument("--scenes names no benchmark scene");
+    }
+    log.line("report: %zu scenes, %d threads, output in %s%s", list.size(), threads, o.out.string().c_str(),
+             o.quick ? " (quick)" : "");
+    std::vector<SceneReport> scenes;
+    std::vector<RunResult> results;
+    std::vector<SpeedupResult> speedups;
+    size_t totalRuns = 0, done = 0;
+    for (const auto& s : list) totalRuns += s.runs.size();
+    for (const auto& s : list) {
+        SceneReport report;
+        report.scene = s;
+        if (!fs::exists(s.file)) {
+            report.skipped = "no " + s.file.string() + (s.shared ? " (the shared scene folder is absent; --shared DIR)" : "");
+            log.line("%s: skipped: %s", s.name.c_str(), report.skipped.c_str());
+            done += s.runs.size();
+            scenes.push_back(report);
+            continue;
+        }
+        const auto loadStart = Clock::now();
+        const auto scene = loadScene(s);
+        report.loadSeconds = secondsSince(loadStart);
+        arena.execute([&] {
+            const Image reference = referenceImage(s, *scene, o.out / "cache", log, report.reference);
+            const float exposure = autoExposure(reference);
+            writePreviewPng(reference, o.out / "images" / (safeName(s.name) + "-reference.png"), exposure);
+            report.images.push_back("Reference and the largest setting of each method (same exposure):\n");
+            std::string row = "| reference |", header = "|---|";
+            std::string imageRow = "| ![](images/" + safeName(s.name) + "-reference.png) |";
+            std::map<std::string, ImageSet> lastOfMethod;
+            std::map<std::string, std::string> lastLabel;
+            for (const auto& run : s.runs) {
+                ++done;
+                const RenderSettings settings = settingsFor(s, run, 1);
+                RenderStatistics stats;
+                const auto runStart = Clock::now();
+                ImageSet images = render(*scene, settings, {}, &stats);
+                RunResult r{s.name, run, secondsSince(runStart), compareImages(reference, images.image), stats};
+                log.line("%s (%zu/%zu): %-13s %-22s %8.2f s  RMSE %.4g  rel %.4g  SMAPE %.4g%s", s.name.c_str(), done,
+                         totalRuns, run.method.c_str(), run.label().c_str(), r.seconds, r.metrics.rmse,
+                         r.metrics.relativeRmse, r.metrics.smape,
+                         r.metrics.nonFinitePixels ? "  (NON-FINITE PIXELS)" : "");
+                if (usesLightTree(run.method) && run.lights == s.tableLights && run.errorThreshold == 0.02f) {
+                    report.tableStats[run.method] = {stats.meanEvaluated, stats.meanIntersected};
+                    for (const char* counter : {"eval", "inter"}) {
+                        if (const Image* layer = layerOf(images, counter))
+                            lastOfMethod[run.method + "/" + counter] = ImageSet{*layer, {}, {}};
+                    }
+                }
+                if (run.method != "vrl-lightcuts" || run.errorThreshold == 0.02f) {
+                    lastOfMethod[run.method] = ImageSet{images.image, {}, {}};
+                    lastLabel[run.method] = run.label();
+                }
+                results.push_back(std::move(r));
+            }
+            for (const auto& m : {"path", "vrl", "vrl-lightcuts", "vpl-lightcuts"}) {
+                if (!lastOfMethod.count(m)) continue;
+                const std::string file = safeName(s.name) + "-" + m + ".png";
+                writePreviewPng(lastOfMethod[m].image, o.out / "images" / file, exposure);
+                row += " " + std::string(methodTitle(m)) + ", " + lastLabel[m] + " |";
+                header += "---|";
+                imageRow += " ![](images/" + file + ") |";
+            }
+            report.images.push_back(row);
+            report.images.push_back(header + "---|");
+            report.images.push_back(imageRow + "\n");
+            // Figure 6: #Eval and #Inter in false colour, one scale per counter for both methods.
+            for (const char* counter : {"eval", "inter"}) {
+                float clip = 0.0f;
+                for (const char* m : {"vpl-lightcuts", "vrl-lightcuts"}) {
+                    const auto it = lastOfMethod.find(std::string(m) + "/" + counter);
+                    if (it != lastOfMethod.end()) clip = std::max(clip, percentileValue(it->second.image, 0.98f));
+                }
+                std::string line = "| #" + std::string(counter == std::string("eval") ? "Eval" : "Inter") +
+                                   " (scale 0 to " + fmt(clip, 4) + ", 98th percentile) |";
+                for (const char* m : {"vpl-lightcuts", "vrl-lightcuts"}) {
+                    const auto it = lastOfMethod.find(std::string(m) + "/" + counter);
+                    if (it == lastOfMethod.end()) continue;
+                    const std::string file = safeName(s.name) + "-" + m + "-" + counter + ".png";
+                    writeFalseColourPng(it->second.image, clip, o.out / "images" / file);
+                    line += " ![" + std::string(methodTitle(m)) + "](images/" + file + ") |";
+                }
+                if (counter == std::string("eval")) {
+                    report.images.push_back("Figure 6 (N = " + std::to_string(s.tableLights) +
+                                            "): left VPL Lightcuts, right VRL Lightcuts.\n");
+                    report.images.push_back("| counter | VPL Lightcuts | VRL Lightcuts |");
+                    report.images.push_back("|---|---|---|");
+                }
+                report.images.push_back(line);
+            }
+            const auto measured = measureSpeedup(s, *scene, log);
+            speedups.insert(speedups.end(), measured.begin(), measured.end());
+        });
+        scenes.push_back(std::move(report));
+        // Write what we have after every scene: a long report interrupted keeps its data.
+        std::ofstream csv(o.out / "results.csv");
+        csv << "scene,method,setting,vrls,spp,error_threshold,seconds,rmse,rel_rmse,smape,mean_eval,mean_inter,mean_cut,mean_ratio\n";
+        csv << std::setprecision(6);
+        for (const auto& r : results)
+            csv << r.scene << "," << r.run.method << "," << r.run.label() << "," << r.run.lights << "," << r.run.spp << ","
+                << r.run.errorThreshold << "," << r.seconds << "," << r.metrics.rmse << "," << r.metrics.relativeRmse << ","
+                << r.metrics.smape << "," << r.stats.meanEvaluated << "," << r.stats.meanIntersected << ","
+                << r.stats.meanCutSize << ","
+                << (r.metrics.meanReference > 0 ? r.metrics.meanTest / r.metrics.meanReference : 0.0) << "\n";
+        std::ofstream sp(o.out / "speedup.csv");
+        sp << "scene,kind,n,brute_seconds_per_pixel,lightcuts_seconds_per_pixel,speedup,mean_eval,mean_inter\n";
+        sp << std::setprecision(6);
+        for (const auto& r : speedups)
+            sp << r.scene << "," << r.kind << "," << r.lights << "," << r.bruteSecondsPerPixel << ","
+               << r.lightcutsSecondsPerPixel << "," << r.bruteSecondsPerPixel / r.lightcutsSecondsPerPixel << ","
+               << r.meanEval << "," << r.meanInter << "\n";
+    }
+    if (results.empty()) throw std::runtime_error("no benchmark scene could be rendered");
+    if (o.plots) {
+        const std::string command = o.python + " " + (fs::path(VRL_SOURCE_DIR) / "bench" / "plot_report.py").string() +
+                                    " --results " + (o.out / "results.csv").string() + " --speedup " +
+                                    (o.out / "speedup.csv").string() + " --out " + o.out.string();
+        log.line("plots: %s", command.c_str());
+        if (std::system(command.c_str()) != 0)
+            throw std::runtime_error("the plot script failed (is python3-matplotlib installed? --no-plots skips it)");
+    }
+    writeSummary(o.out / "summary.md", o, scenes, results, speedups, secondsSince(start), threads);
+    log.line("report done in %.1f min: %s", secondsSince(start) / 60.0, (o.out / "summary.md").string().c_str());
+    return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+    CLI::App app{"vrl_report: error against run time for path tracing, plain VRLs, VRL Lightcuts and VPL Lightcuts "
+                 "on the benchmark scenes (CSV, plots, false-colour statistics, Markdown summary)"};
+    Options o;
+    app.add_option("-o,--out", o.out, "Output folder (created); references are cached in OUT/cache (default report)");
+    app.add_flag("--quick", o.quick, "A small version (our own scene at 32x24, short sweeps): under 3 minutes");
+    app.add_option("--scenes", o.only, "Only these scenes (names as in the summary), comma-separated")->delimiter(',');
+    app.add_option("--shared", o.shared, "The shared scene folder with staircase/, veach-lamp-mitsuba-bidir/, "
+                                         "volumetric-caustic/ (default ../shared/scenes beside the repository)");
+    app.add_option("--threads", o.threads, "Threads (default: all cores)")->check(CLI::Range(1, 4096));
+    app.add_option("--python", o.python, "Python with matplotlib for the plots (default /usr/bin/python3)");
+    bool noPlots = false;
+    app.add_flag("--no-plots", noPlots, "Skip the plots (CSV, images and summary only)");
+    CLI11_PARSE(app, argc, argv);
+    o.plots = !noPlots;
+    spdlog::set_level(spdlog::level::err);  // per-render warnings would repeat for every run
+    try {
+        return runReport(o);
+    } catch (const std::exception& e) {
+        std::fprintf(stderr, "vrl_report: error: %s\n", e.what());
+        return 1;
+    }
+}
