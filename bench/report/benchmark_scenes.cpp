@@ -14,25 +14,31 @@ std::string compactCount(uint64_t n) {
     return buffer;
 }
 
-// The sweep every scene gets, scaled by `scale` (1 for the full report).
-std::vector<MethodRun> sweep(bool quick, int sppVirtual) {
+// The sweep every scene gets. Parts (a)-(c) of the virtual-light methods are
+// path-sampled, and their noise counts in the image's error like (d)'s: the
+// samples per pixel grow with the number of lights along each curve, as a user
+// buying a better image would do.
+std::vector<MethodRun> sweep(bool quick) {
     std::vector<MethodRun> runs;
     if (quick) {
-        runs.push_back({"path", 0, 4});
-        runs.push_back({"path", 0, 16});
-        runs.push_back({"vrl", 1000, sppVirtual});
-        runs.push_back({"vrl", 3000, sppVirtual});
-        runs.push_back({"vrl-lightcuts", 3000, sppVirtual, 0.02f});
-        runs.push_back({"vrl-lightcuts", 10000, sppVirtual, 0.02f});
-        runs.push_back({"vpl-lightcuts", 3000, sppVirtual, 0.02f});
-        runs.push_back({"vpl-lightcuts", 10000, sppVirtual, 0.02f});
+        for (int spp : {4, 16, 64}) runs.push_back({"path", 0, spp});
+        runs.push_back({"vrl", 1000, 16});
+        runs.push_back({"vrl", 3000, 64});
+        runs.push_back({"vrl-lightcuts", 3000, 16, 0.02f});
+        runs.push_back({"vrl-lightcuts", 10000, 64, 0.02f});
+        runs.push_back({"vrl-lightcuts", 10000, 64, 0.1f});
+        runs.push_back({"vpl-lightcuts", 3000, 16, 0.02f});
+        runs.push_back({"vpl-lightcuts", 10000, 64, 0.02f});
         return runs;
     }
-    for (int spp : {4, 16, 64, 256}) runs.push_back({"path", 0, spp});
-    for (uint64_t n : {1000ULL, 4000ULL, 16000ULL}) runs.push_back({"vrl", n, sppVirtual});
-    for (uint64_t n : {10000ULL, 100000ULL, 1000000ULL}) runs.push_back({"vrl-lightcuts", n, sppVirtual, 0.02f});
-    for (uint64_t n : {10000ULL, 100000ULL}) runs.push_back({"vrl-lightcuts", n, sppVirtual, 0.1f});
-    for (uint64_t n : {10000ULL, 100000ULL, 1000000ULL}) runs.push_back({"vpl-lightcuts", n, sppVirtual, 0.02f});
+    for (int spp : {16, 64, 256, 1024, 2048}) runs.push_back({"path", 0, spp});
+    const std::pair<uint64_t, int> plain[] = {{1000, 64}, {4000, 256}, {16000, 1024}};
+    for (const auto& [n, spp] : plain) runs.push_back({"vrl", n, spp});
+    const std::pair<uint64_t, int> many[] = {{10000, 64}, {100000, 256}, {1000000, 1024}};
+    for (const auto& [n, spp] : many) runs.push_back({"vrl-lightcuts", n, spp, 0.02f});
+    for (const auto& [n, spp] : many)
+        if (n < 1000000) runs.push_back({"vrl-lightcuts", n, spp, 0.1f});
+    for (const auto& [n, spp] : many) runs.push_back({"vpl-lightcuts", n, spp, 0.02f});
     return runs;
 }
 
@@ -43,9 +49,9 @@ std::string MethodRun::label() const {
     if (method == "path") {
         std::snprintf(buffer, sizeof buffer, "%d spp", spp);
     } else if (method == "vrl" || method == "vpl") {
-        std::snprintf(buffer, sizeof buffer, "N=%s, %d spp", compactCount(lights).c_str(), spp);
+        std::snprintf(buffer, sizeof buffer, "N=%s %d spp", compactCount(lights).c_str(), spp);
     } else {
-        std::snprintf(buffer, sizeof buffer, "N=%s, e=%g, %d spp", compactCount(lights).c_str(), double(errorThreshold), spp);
+        std::snprintf(buffer, sizeof buffer, "N=%s e=%g %d spp", compactCount(lights).c_str(), double(errorThreshold), spp);
     }
     return buffer;
 }
@@ -60,15 +66,15 @@ std::vector<BenchmarkScene> benchmarkScenes(bool quick, const std::filesystem::p
         s.file = repository / "scenes" / "bathroom-spots.xml";
         s.defines = std::move(defines);
         if (quick) {
-            s.width = 32, s.height = 24, s.referenceSpp = 256;
+            s.width = 32, s.height = 24, s.referenceSpp = 1024;
             s.tableLights = 10000;
             s.speedupLights = {1000, 10000};
         } else {
-            s.width = 96, s.height = 72, s.referenceSpp = 4096;
+            s.width = 80, s.height = 60, s.referenceSpp = 8192;
             s.tableLights = 100000;
             s.speedupLights = {1000, 10000, 100000, 1000000};
         }
-        s.runs = sweep(quick, 4);
+        s.runs = sweep(quick);
         return s;
     };
     scenes.push_back(own("bathroom", "our own scene in the spirit of the paper's BATHROOM: two spot lights in an "
@@ -85,17 +91,17 @@ std::vector<BenchmarkScene> benchmarkScenes(bool quick, const std::filesystem::p
         s.shared = true;
         s.medium = std::move(medium);
         s.width = width, s.height = height, s.referenceSpp = referenceSpp;
-        s.runs = sweep(false, 4);
+        s.runs = sweep(false);
         s.tableLights = 100000;
         s.speedupLights = {1000, 10000, 100000, 1000000};
         return s;
     };
     scenes.push_back(paper("staircase", "the paper's STAIRCASE: one area light at the top, filled with dense smoke",
-                           "staircase/scene.xml", "sigmaS=0.1,sigmaA=0.02", 54, 96, 4096));
+                           "staircase/scene.xml", "sigmaS=0.1,sigmaA=0.02", 54, 96, 8192));
     scenes.push_back(paper("veach-lamp", "the paper's VEACH-LAMP: lamps with shades, filled with smoke",
-                           "veach-lamp-mitsuba-bidir/scene.xml", "sigmaS=0.2,sigmaA=0.04", 96, 54, 4096));
+                           "veach-lamp-mitsuba-bidir/scene.xml", "sigmaS=0.2,sigmaA=0.04", 96, 54, 8192));
     scenes.push_back(paper("volumetric-caustic", "Bitterli's volumetric caustic as it is (smoke-filled box, glass sphere)",
-                           "volumetric-caustic/scene_v0.6.xml", "", 64, 64, 4096));
+                           "volumetric-caustic/scene_v0.6.xml", "", 64, 64, 8192));
     return scenes;
 }
 

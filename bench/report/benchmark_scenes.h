@@ -18,7 +18,7 @@ struct MethodRun {
     uint64_t lights = 0;
     int spp = 1;
     float errorThreshold = 0.02f;
-    std::string label() const;
+    std::string label() const;  // no commas (a CSV field)
 };
 
 struct BenchmarkScene {

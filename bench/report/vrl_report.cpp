@@ -309,8 +309,9 @@ void writeSummary(const fs::path& path, const Options& o, const std::vector<Scen
     md << "Every image is compared with a path-traced reference (two independent halves; the noise columns are the "
           "reference's own estimated error, RMSE(half1, half2) / 2, below which no method can be measured). "
           "Times are wall-clock seconds of light tracing, tree build and shading; the scene load is common to all "
-          "methods and left out. Virtual-light methods render parts (a)-(c) by path sampling at the stated spp and "
-          "multiple scattering (d) with their lights; Lightcuts at relative error threshold e (0.02 unless stated); "
+          "methods and left out. Virtual-light methods render parts (a)-(c) by path sampling at the stated spp (their "
+          "noise is part of the error, and the spp grow with N along each curve) and multiple scattering (d) with "
+          "their lights; Lightcuts at relative error threshold e (0.02 unless stated); "
           "VPL Lightcuts gathers at 32 stratified distance samples per camera segment without clamping, as in the "
           "paper. Errors are on luminance; SMAPE uses epsilon 0.01. Rays pass through pixel centres; maximum path "
           "length 12.\n\n";
@@ -433,7 +434,8 @@ int runReport(const Options& o) {
             std::map<std::string, std::string> lastLabel;
             for (const auto& run : s.runs) {
                 ++done;
-                const RenderSettings settings = settingsFor(s, run, 1);
+                // Every run its own seed: no two share the noise of parts (a)-(c).
+                const RenderSettings settings = settingsFor(s, run, 1 + (&run - s.runs.data()));
                 RenderStatistics stats;
                 const auto runStart = Clock::now();
                 ImageSet images = render(*scene, settings, {}, &stats);
