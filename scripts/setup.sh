@@ -10,7 +10,7 @@ packages=(
   libopenimageio-dev
   libgtest-dev libgmock-dev
   libgrpc++-dev libprotobuf-dev protobuf-compiler protobuf-compiler-grpc
-  python3 python3-numpy python3-yaml openssl iproute2
+  python3 python3-numpy python3-yaml python3-matplotlib openssl iproute2
 )
 
 missing=()
