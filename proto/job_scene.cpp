@@ -1,5 +1,6 @@
 #include "proto/job_scene.h"
 
+#include "proto/rpc_common.h"
 #include "render/medium_fill.h"
 
 #include "render/mitsuba_parser.h"
@@ -10,6 +11,10 @@
 #include <string>
 
 namespace vrl::rpc {
+
+namespace {
+constexpr int kMaxDepth = 100000;  // as `vrl render --max-depth`
+}  // namespace
 
 int jobTileSize(const v1::JobSpec& spec) { return spec.tile_size() == 0 ? 32 : int(spec.tile_size()); }
 
@@ -34,9 +39,18 @@ v1::RenderParameters defaultRenderParameters(const std::string& method) {
 }
 
 void validateJobSpec(const v1::JobSpec& spec, const ServiceLimits& limits) {
+    // What a spec may hold at most (its size also bounds every lease reply that carries it).
+    constexpr size_t kMaxSpecBytes = 256 << 10, kMaxDefines = 1024, kMaxNameBytes = 4096, kMaxTransportBytes = 256;
+    if (spec.ByteSizeLong() > kMaxSpecBytes)
+        throw JobSpecError("the job spec is " + std::to_string(spec.ByteSizeLong()) + " bytes, over the limit of " +
+                           std::to_string(kMaxSpecBytes));
+    if (!spec.has_parameters()) throw JobSpecError("the job has no parameters (method, samples, resolution, ...)");
     const auto& p = spec.parameters();
-    if (std::find(kRenderMethods.begin(), kRenderMethods.end(), p.method()) == kRenderMethods.end())
-        throw JobSpecError("unknown method '" + p.method() + "' (valid: path, vrl, vrl-lightcuts)");
+    if (std::find(kRenderMethods.begin(), kRenderMethods.end(), p.method()) == kRenderMethods.end()) {
+        std::string valid;
+        for (const auto& m : kRenderMethods) valid += (valid.empty() ? "" : ", ") + m;
+        throw JobSpecError("unknown method '" + abbreviate(p.method()) + "' (valid: " + valid + ")");
+    }
     if (spec.tile_size() > limits.maxTileSize)
         throw JobSpecError("tile size " + std::to_string(spec.tile_size()) + " exceeds the limit of " +
                            std::to_string(limits.maxTileSize));
@@ -46,22 +60,61 @@ void validateJobSpec(const v1::JobSpec& spec, const ServiceLimits& limits) {
     if (p.vrl_count() > limits.maxVrls || p.light_paths() > limits.maxVrls)
         throw JobSpecError("the job asks for more than " + std::to_string(limits.maxVrls) +
                            " VRLs or light paths, this coordinator's limit");
-    if (p.max_depth() < -2 || p.max_depth() == 0)
-        throw JobSpecError("max depth must be -2 (the scene's), -1 (unbounded) or positive");
-    if (p.vrl_samples() < 1 || p.vrl_samples() > 1024) throw JobSpecError("VRL samples must be in 1...1024");
-    if (!(p.error() >= 0.0f) || !std::isfinite(p.error())) throw JobSpecError("the error threshold must be >= 0");
-    if (!(p.hg_epsilon() >= 0.0f) || !std::isfinite(p.hg_epsilon())) throw JobSpecError("hg epsilon must be >= 0");
-    if (p.partition_size() < 2) throw JobSpecError("the partition size must be at least 2");
+    if (p.max_depth() < -2 || p.max_depth() == 0 || p.max_depth() > kMaxDepth)
+        throw JobSpecError("max depth must be -2 (the scene's), -1 (unbounded) or 1..." + std::to_string(kMaxDepth) +
+                           ", got " + std::to_string(p.max_depth()));
+    if (p.vrl_samples() < 1 || p.vrl_samples() > 1024)
+        throw JobSpecError("VRL samples must be in 1...1024, got " + std::to_string(p.vrl_samples()));
+    if (!(p.error() >= 0.0f && p.error() <= 1e6f))
+        throw JobSpecError("the error threshold must be in 0...1e6, got " + std::to_string(p.error()));
+    if (!(p.hg_epsilon() >= 0.0f && p.hg_epsilon() <= 1e6f))
+        throw JobSpecError("hg epsilon must be in 0...1e6, got " + std::to_string(p.hg_epsilon()));
+    if (p.max_cut() < 1 || p.max_cut() > (1u << 30))
+        throw JobSpecError("the maximum cut size must be in 1..." + std::to_string(1u << 30) + ", got " +
+                           std::to_string(p.max_cut()));
+    if (p.exact_distance_below() > (1u << 20))
+        throw JobSpecError("exact distance below must be in 0..." + std::to_string(1u << 20) + ", got " +
+                           std::to_string(p.exact_distance_below()));
+    if (p.partition_size() < 2 || p.partition_size() > (1u << 30))
+        throw JobSpecError("the partition size must be in 2..." + std::to_string(1u << 30) + ", got " +
+                           std::to_string(p.partition_size()));
     if ((p.width() == 0) != (p.height() == 0)) throw JobSpecError("give both width and height, or neither");
+    if (p.width() > 0) {
+        const uint64_t pixels = uint64_t(p.width()) * p.height();
+        if (p.width() > uint32_t(kMaxFilmSide) || p.height() > uint32_t(kMaxFilmSide) || pixels > limits.maxPixels)
+            throw JobSpecError("resolution " + std::to_string(p.width()) + "x" + std::to_string(p.height()) +
+                               " is outside the supported range (1.." + std::to_string(kMaxFilmSide) +
+                               " per side, at most " + std::to_string(limits.maxPixels) + " pixels)");
+        const uint64_t side = uint64_t(jobTileSize(spec));
+        const uint64_t tiles = ((p.width() + side - 1) / side) * ((p.height() + side - 1) / side);
+        if (tiles > limits.maxTiles)
+            throw JobSpecError("the image would have " + std::to_string(tiles) + " tiles, over the limit of " +
+                               std::to_string(limits.maxTiles) + "; use a larger tile size");
+    }
+    if (spec.defines_size() > int(kMaxDefines))
+        throw JobSpecError("the job has " + std::to_string(spec.defines_size()) + " defines, over the limit of " +
+                           std::to_string(kMaxDefines));
     for (const auto& [name, value] : spec.defines())
-        if (name.empty() || name.size() > 256 || value.size() > 4096) throw JobSpecError("invalid define '" + name + "'");
+        if (name.empty() || name.size() > 256 || value.size() > 4096)
+            throw JobSpecError("invalid define '" + abbreviate(name) + "' (" + std::to_string(name.size()) +
+                               "-byte name, " + std::to_string(value.size()) +
+                               "-byte value): names are 1..256 bytes, values at most 4096");
+    if (spec.name().size() > kMaxNameBytes)
+        throw JobSpecError("the job name is " + std::to_string(spec.name().size()) + " bytes, over the limit of " +
+                           std::to_string(kMaxNameBytes));
     if (spec.medium().size() > 1024) throw JobSpecError("the fill medium description is longer than 1024 bytes");
+    if (p.transport().size() > kMaxTransportBytes)
+        throw JobSpecError("the transport list is " + std::to_string(p.transport().size()) +
+                           " bytes, over the limit of " + std::to_string(kMaxTransportBytes));
+    TransportSelection transports;
     try {
         if (!spec.medium().empty()) (void)parseFillMedium(spec.medium());
-        (void)TransportSelection::parse(p.transport());
+        transports = TransportSelection::parse(p.transport());
     } catch (const std::exception& e) {
         throw JobSpecError(e.what());
     }
+    if (p.method() != "path" && transports.has(TransportPart::Multiple) && p.vrl_count() == 0 && p.light_paths() == 0)
+        throw JobSpecError("method " + p.method() + " needs a VRL count or a number of light paths (both are 0)");
 }
 
 JobScene loadJobScene(const std::filesystem::path& bundleDirectory, const std::filesystem::path& sceneFile,

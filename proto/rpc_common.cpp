@@ -159,4 +159,9 @@ std::string describe(const grpc::Status& status) {
     return name + ": " + status.error_message();
 }
 
+std::string abbreviate(std::string_view text, size_t max) {
+    if (text.size() <= max) return std::string(text);
+    return std::string(text.substr(0, max)) + "... (" + std::to_string(text.size()) + " bytes)";
+}
+
 }  // namespace vrl::rpc

@@ -70,4 +70,9 @@ std::string randomHex(size_t digits);
 // "DEADLINE_EXCEEDED: message" for logs and errors.
 std::string describe(const grpc::Status& status);
 
+// `text` for an error message or a log line: itself when at most `max` bytes,
+// else its first `max` bytes and "... (N bytes)". Keeps what a caller sent
+// (an id, a name) from blowing up a status message past gRPC's metadata limit.
+std::string abbreviate(std::string_view text, size_t max = 64);
+
 }  // namespace vrl::rpc

@@ -1,5 +1,7 @@
 #include "proto/scene_bundle.h"
 
+#include "proto/rpc_common.h"
+
 #include <fstream>
 #include <set>
 #include <sstream>
@@ -96,7 +98,7 @@ v1::SceneBundle parseBundleBlob(const std::string& blob, const ServiceLimits& li
             throw BundleError("bundle entry '" + path + "' is both a file and a directory");
     }
     if (!paths.count(bundle.scene_path()))
-        throw BundleError("the bundle's scene file '" + bundle.scene_path() + "' is not among its entries");
+        throw BundleError("the bundle's scene file '" + abbreviate(bundle.scene_path()) + "' is not among its entries");
     return bundle;
 }
 

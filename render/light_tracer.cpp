@@ -20,7 +20,11 @@ constexpr uint64_t kChunksPerBatch = 32;
 
 class LightPathTracer {
 public:
-    LightPathTracer(const Scene& scene, const LightTracingSettings& settings) : scene_(scene), settings_(settings) {}
+    LightPathTracer(const Scene& scene, const LightTracingSettings& settings)
+        : scene_(scene), settings_(settings), areaEmitter_(scene.emitters().size(), 0) {
+        for (const SceneShape& shape : scene.shapes())
+            if (shape.emitter >= 0) areaEmitter_[shape.emitter] = 1;
+    }
 
     // Appends the VRLs of light path `index` to `out` (flux not yet divided by the path count).
     void trace(uint64_t index, std::vector<Vrl>& out) const {
@@ -39,6 +43,22 @@ public:
         const Vec3& p = ray.origin;
         ray.tMin = 1e-4f * positionScale(p);  // leave the emitter
         int medium = emitter.medium;
+        if (!areaEmitter_[emitterIndex]) {
+            // A point or spot light on a medium boundary, or closer to one than the
+            // offset above (which the ray then skips), emits into the medium on the
+            // side each ray points to, which one emitter medium cannot say: a light
+            // 1e-6 inside a null-bounded medium sent its outward rays on through the
+            // vacuum as if still in the medium (VRLs outside it, +24% in
+            // stiff_cases), and one exactly on the boundary, located outside, lit
+            // nothing inside (-56%). The nearest surface within the offset, ahead of
+            // or behind the light, decides when it changes media.
+            const Ray probe{p - ray.direction * ray.tMin, ray.direction, 2.0f * ray.tMin};
+            if (const auto hit = scene_.intersect(probe)) {
+                const SceneShape& shape = scene_.shapes()[hit->shape];
+                if (shape.changesMedium)
+                    medium = ray.direction.dot(hit->geometricNormal) < 0.0f ? shape.interiorMedium : shape.exteriorMedium;
+            }
+        }
         int vertices = 0;  // real scattering vertices so far; the current segment is number vertices + 1
         float segmentStart = 0.0f;
         int mediumBeforeCrossing = medium;  // before the last null boundary crossed
@@ -64,9 +84,21 @@ public:
                     // Spectral tracking against the majorant: each collision-free stretch is one VRL.
                     const Rgb sigmaT = m.sigmaT(), sigmaS = m.sigmaS();
                     const float majorant = maxComponent(sigmaT);
-                    const float nullWeight = average(Rgb(majorant) - sigmaT), realWeight = average(sigmaS);
-                    const float pReal = realWeight / (realWeight + nullWeight);
                     while (true) {
+                        // History-aware spectral tracking (Kutz et al. 2017): real and null
+                        // events in proportion to the throughput-weighted coefficients. With
+                        // fixed channel averages, the null weight (majorant - sigma_t) /
+                        // (majorant (1 - pReal)) of a thin channel exceeds 1 and compounds
+                        // over the many null collisions a thick channel's majorant makes:
+                        // unbiased, but heavy-tailed enough that at practical VRL counts the
+                        // thin channels come out far too low (a cube with sigma_t (1e-2, 1,
+                        // 1e2): green 23% low with 4000 VRLs). Grey media: no null events,
+                        // pReal = 1 as before.
+                        const float nullWeight = average(throughput * (Rgb(majorant) - sigmaT));
+                        const float realWeight = average(throughput * sigmaS);
+                        // No channel that still carries light scatters: null events only
+                        // (ratio tracking of the transmittance, also when nullWeight = 0).
+                        const float pReal = realWeight > 0.0f ? realWeight / (realWeight + nullWeight) : 0.0f;
                         const float t = segmentStart - std::log1p(-rng.next()) / majorant;
                         const float end = std::min(t, tSurface);
                         if (!points && std::isfinite(end) && end > segmentStart)
@@ -120,6 +152,7 @@ public:
 private:
     const Scene& scene_;
     const LightTracingSettings& settings_;
+    std::vector<char> areaEmitter_;  // by emitter index: emits from a surface
 };
 
 }  // namespace

@@ -100,13 +100,13 @@ void ParseContext::reportIgnored(const xml::Element& plugin, const std::string& 
     const std::string subject = plugin.tag() + " '" + type + "'";
     auto it = std::find_if(ignored_.begin(), ignored_.end(), [&](const Ignored& i) { return i.subject == subject; });
     if (it == ignored_.end()) {
-        ignored_.push_back({subject, reason, {}, plugin.where(), warn});
+        ignored_.push_back({subject, reason, {}, plugin.where(), warn, {}});
         it = std::prev(ignored_.end());
     }
     it->warn = it->warn || warn;
+    // A set beside the list keeps this linear in the parameters a hostile file can repeat.
     for (const std::string& parameter : parameters)
-        if (std::find(it->parameters.begin(), it->parameters.end(), parameter) == it->parameters.end())
-            it->parameters.push_back(parameter);
+        if (it->seen.insert(parameter).second) it->parameters.push_back(parameter);
 }
 
 void ParseContext::reportIgnoredParameters(const xml::PluginParams& params, const xml::Element& plugin,

@@ -17,6 +17,7 @@
 #include <span>
 #include <string>
 #include <string_view>
+#include <unordered_set>
 #include <vector>
 
 #include "render/mitsuba_parser.h"
@@ -110,6 +111,7 @@ private:
         std::vector<std::string> parameters;
         SourceLocation where;  // first occurrence
         bool warn = false;
+        std::unordered_set<std::string> seen;  // the names in `parameters`
     };
 
     std::optional<std::filesystem::path> confineTo_;

@@ -98,8 +98,32 @@ std::vector<std::string> renderLayerNames(const RenderSettings& settings) {
     return names;
 }
 
+namespace {
+
+// Lights that arrive from elsewhere (a deserialised blob) must belong to this
+// scene: every medium index in range, or shading would index out of bounds.
+void checkLightsMatchScene(const Scene& scene, const RenderLights& lights) {
+    const size_t media = scene.media().size();
+    const auto check = [&](const std::vector<Vrl>& vrls) {
+        for (size_t k = 0; k < vrls.size(); ++k)
+            if (vrls[k].medium < 0 || size_t(vrls[k].medium) >= media)
+                throw std::invalid_argument("light " + std::to_string(k) + " lies in medium " +
+                                            std::to_string(vrls[k].medium) + " but the scene has " +
+                                            std::to_string(media) + " media: the lights do not belong to this scene");
+    };
+    check(lights.vrls.vrls);
+    check(lights.tree.vrls());
+    for (const LightTreeNode& node : lights.tree.nodes())
+        if (node.medium < -1 || node.medium >= int32_t(media))
+            throw std::invalid_argument("a light-tree node names medium " + std::to_string(node.medium) +
+                                        " but the scene has " + std::to_string(media) + " media");
+}
+
+}  // namespace
+
 TileShader::TileShader(const Scene& scene, const RenderSettings& settings, const RenderLights& lights)
     : scene_(scene), settings_(settings), layerNames_(renderLayerNames(settings)) {
+    checkLightsMatchScene(scene, lights);
     if (isVrlMethod(settings)) {
         const bool lightcuts = usesLightTree(settings.method);
         VrlIntegratorSettings integratorSettings{settings.transports, settings.maxDepth, settings.vrlSamples,

@@ -310,6 +310,12 @@ std::optional<SurfaceHit> Scene::intersect(const Ray& ray) const {
     const auto& tri = mesh.triangles[hit.triangle];
     const float u = rayHit.hit.u, v = rayHit.hit.v;
     hit.position = mesh.positions[tri[0]] * (1 - u - v) + mesh.positions[tri[1]] * u + mesh.positions[tri[2]] * v;
+    float scale = 0.0f;
+    for (int k = 0; k < 3; ++k) {
+        const Vec3& q = mesh.positions[tri[k]];
+        scale = std::max({scale, std::abs(q.x), std::abs(q.y), std::abs(q.z)});
+    }
+    hit.scale = std::max(scale, 1e-30f);
     hit.geometricNormal = mesh.geometricNormal(hit.triangle);
     hit.shadingNormal = mesh.shadingNormal(hit.triangle, u, v);
     hit.uv = mesh.texcoord(hit.triangle, u, v);
@@ -337,14 +343,13 @@ bool Scene::occluded(const Ray& ray) const {
 
 Vec3 Scene::offsetOrigin(const SurfaceHit& hit, const Vec3& direction) {
     const Vec3& p = hit.position;
-    const float scale = positionScale(p);
+    const float scale = hit.scale;
     const float side = direction.dot(hit.geometricNormal) >= 0.0f ? 1.0f : -1.0f;
     return p + hit.geometricNormal * (side * 1e-4f * scale);
 }
 
 void Scene::continuePast(Ray& ray, const SurfaceHit& hit) {
-    const Vec3& p = hit.position;
-    const float scale = positionScale(p);
+    const float scale = hit.scale;
     // Grazing hits widen the window only so far.
     const float cosine = std::max(std::abs(ray.direction.dot(hit.geometricNormal)), 0.1f);
     // Float noise around the crossing: a surface coinciding with the one crossed

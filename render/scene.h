@@ -35,6 +35,7 @@ struct SurfaceHit {
     Vec2 uv{0.0f, 0.0f};   // texture coordinates (barycentrics for meshes without uvs)
     uint32_t shape = 0;
     uint32_t triangle = 0;
+    float scale = 1.0f;  // largest |coordinate| of the hit triangle's vertices (offsets scale with it)
 
     ShadingPoint shadingPoint() const { return {geometricNormal, shadingNormal, uv}; }
 };

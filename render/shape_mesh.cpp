@@ -130,19 +130,20 @@ TriangleMesh loadObj(const ShapeDescription& shape) {
             for (int k = 0; k < 3; ++k) {
                 const tinyobj::index_t& corner = idx[f + k];
                 const int vi = corner.vertex_index;
-                if (vi < 0 || size_t(3 * vi + 2) >= attrib.vertices.size()) throw invalid("vertex");
-                m.positions.push_back({attrib.vertices[3 * vi], attrib.vertices[3 * vi + 1], attrib.vertices[3 * vi + 2]});
+                // In size_t: 3 * vi overflows int for indices above 715 million (fuzzing found it).
+                if (vi < 0 || 3 * size_t(vi) + 2 >= attrib.vertices.size()) throw invalid("vertex");
+                m.positions.push_back({attrib.vertices[3 * size_t(vi)], attrib.vertices[3 * size_t(vi) + 1], attrib.vertices[3 * size_t(vi) + 2]});
                 if (useNormals) {
                     const int ni = corner.normal_index;
-                    if (haveNormals && size_t(3 * ni + 2) >= attrib.normals.size()) throw invalid("normal");
-                    m.normals.push_back(haveNormals ? Vec3(attrib.normals[3 * ni], attrib.normals[3 * ni + 1],
-                                                           attrib.normals[3 * ni + 2])
+                    if (haveNormals && 3 * size_t(ni) + 2 >= attrib.normals.size()) throw invalid("normal");
+                    m.normals.push_back(haveNormals ? Vec3(attrib.normals[3 * size_t(ni)], attrib.normals[3 * size_t(ni) + 1],
+                                                           attrib.normals[3 * size_t(ni) + 2])
                                                     : Vec3(0.0f));
                 }
                 if (useTexcoords) {
                     const int ti = corner.texcoord_index;
-                    if (ti >= 0 && size_t(2 * ti + 1) >= attrib.texcoords.size()) throw invalid("texture coordinate");
-                    m.texcoords.push_back(ti >= 0 ? Vec2(attrib.texcoords[2 * ti], attrib.texcoords[2 * ti + 1])
+                    if (ti >= 0 && 2 * size_t(ti) + 1 >= attrib.texcoords.size()) throw invalid("texture coordinate");
+                    m.texcoords.push_back(ti >= 0 ? Vec2(attrib.texcoords[2 * size_t(ti)], attrib.texcoords[2 * size_t(ti) + 1])
                                                   : Vec2(0.0f));
                 }
             }

@@ -160,6 +160,18 @@ XmlFile::XmlFile(std::string text, std::string displayName, std::filesystem::pat
         throw SceneError({displayName_, lineAtOffset(result.offset), ""},
                          std::string("malformed XML: ") + result.description());
     }
+    // The scene parser recurses into nested plugins (bsdfs, textures, integrators):
+    // refuse absurd nesting here, iteratively, rather than overflow the stack later.
+    std::vector<std::pair<pugi::xml_node, int>> stack{{document_.document_element(), 1}};
+    while (!stack.empty()) {
+        const auto [node, depth] = stack.back();
+        stack.pop_back();
+        if (depth > kMaxXmlDepth)
+            throw SceneError({displayName_, lineOf(node), ""},
+                             "elements nested deeper than " + std::to_string(kMaxXmlDepth) + " levels");
+        for (const pugi::xml_node child : node.children())
+            if (child.type() == pugi::node_element) stack.emplace_back(child, depth + 1);
+    }
 }
 
 int XmlFile::lineAtOffset(std::ptrdiff_t offset) const {

@@ -27,6 +27,10 @@
 
 namespace vrl::xml {
 
+// Deepest element nesting a scene file may have (real scenes stay below 10);
+// deeper files are refused with a SceneError naming the line.
+inline constexpr int kMaxXmlDepth = 64;
+
 // One parsed XML file. Keeps its text so that node offsets map to lines.
 class XmlFile {
 public:

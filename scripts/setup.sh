@@ -11,6 +11,7 @@ packages=(
   libgtest-dev libgmock-dev
   libgrpc++-dev libprotobuf-dev protobuf-compiler protobuf-compiler-grpc
   python3 python3-numpy python3-yaml python3-matplotlib openssl iproute2
+  clang libclang-rt-dev llvm  # fuzz/: clang++, libFuzzer and sanitizer runtimes, llvm-symbolizer
 )
 
 missing=()

@@ -42,6 +42,34 @@ bool validHash(const std::string& sha256) {
            std::all_of(sha256.begin(), sha256.end(), [](char c) { return (c >= '0' && c <= '9') || (c >= 'a' && c <= 'f'); });
 }
 
+// Refuses (InvalidArgument) a missing or malformed SHA-256 in the field `what`.
+void requireHash(const std::string& sha256, const char* what) {
+    if (sha256.empty())
+        throw ServiceError(ErrorKind::InvalidArgument, std::string(what) + " is required (a SHA-256: 64 lowercase hex digits)");
+    if (!validHash(sha256))
+        throw ServiceError(ErrorKind::InvalidArgument, std::string(what) + " '" + rpc::abbreviate(sha256) +
+                                                           "' is not a SHA-256 (64 lowercase hex digits)");
+}
+
+void requireWorkerId(const std::string& workerId) {
+    if (workerId.empty())
+        throw ServiceError(ErrorKind::InvalidArgument, "worker_id is required (the id Register returned)");
+}
+
+// A lease id this coordinator issued for `tile` of `jobId` ("job:tile:n", n <= lastLease); it may have expired since.
+bool leaseWasIssued(const std::string& leaseId, const std::string& jobId, uint32_t tile, uint64_t lastLease) {
+    const std::string prefix = jobId + ":" + std::to_string(tile) + ":";
+    if (leaseId.size() <= prefix.size() || leaseId.size() > prefix.size() + 19 ||
+        leaseId.compare(0, prefix.size(), prefix) != 0)
+        return false;
+    const std::string number = leaseId.substr(prefix.size());  // 1..19 digits: stoull cannot overflow
+    if (!std::all_of(number.begin(), number.end(), [](char c) { return c >= '0' && c <= '9'; })) return false;
+    const unsigned long long n = std::stoull(number);
+    return n >= 1 && n <= lastLease;
+}
+
+constexpr size_t kMaxMessageBytes = 4096;  // a job's failure message as stored and shown
+
 }  // namespace
 
 struct Coordinator::Job {
@@ -149,11 +177,12 @@ void Coordinator::loadState() {
 // ------------------------------------------------------------------ bundles and jobs
 
 bool Coordinator::hasBundle(const std::string& sha256) const {
-    return validHash(sha256) && fs::exists(options_.stateDir / "bundles" / (sha256 + ".bundle"));
+    requireHash(sha256, "sha256");
+    return fs::exists(options_.stateDir / "bundles" / (sha256 + ".bundle"));
 }
 
 void Coordinator::storeBundle(const std::string& sha256, const std::string& blob) {
-    if (!validHash(sha256)) throw ServiceError(ErrorKind::InvalidArgument, "a bundle hash is 64 lowercase hex digits");
+    requireHash(sha256, "the bundle's sha256");
     const std::string actual = rpc::sha256Hex(blob);
     if (actual != sha256)
         throw ServiceError(ErrorKind::InvalidArgument,
@@ -176,6 +205,7 @@ std::string Coordinator::submitJob(const v1::JobSpec& spec) {
     } catch (const rpc::JobSpecError& e) {
         throw ServiceError(ErrorKind::InvalidArgument, e.what());
     }
+    requireHash(spec.bundle_sha256(), "bundle_sha256");
     if (!hasBundle(spec.bundle_sha256()))
         throw ServiceError(ErrorKind::NotFound, "no scene bundle " + spec.bundle_sha256() + " here; upload it first");
     auto job = std::make_unique<Job>();
@@ -199,8 +229,9 @@ std::string Coordinator::submitJob(const v1::JobSpec& spec) {
 }
 
 Coordinator::Job& Coordinator::findJob(const std::string& jobId) const {
+    if (jobId.empty()) throw ServiceError(ErrorKind::InvalidArgument, "job_id is required");
     const auto it = jobs_.find(jobId);
-    if (it == jobs_.end()) throw ServiceError(ErrorKind::NotFound, "no job '" + jobId + "'");
+    if (it == jobs_.end()) throw ServiceError(ErrorKind::NotFound, "no job '" + rpc::abbreviate(jobId) + "'");
     return *it->second;
 }
 
@@ -281,7 +312,7 @@ void Coordinator::touch(Job& job) {
 
 void Coordinator::endJob(Job& job, v1::JobState state, const std::string& message) {
     job.state = state;
-    job.message = message;
+    job.message = rpc::abbreviate(message, kMaxMessageBytes);  // shown in every listing: bounded
     job.pending.clear();
     for (auto it = leases_.begin(); it != leases_.end();)
         it = it->second.jobId == job.id ? leases_.erase(it) : std::next(it);
@@ -464,7 +495,7 @@ void Coordinator::prepare(Job& job) {
 v1::RegisterReply Coordinator::registerWorker(const v1::RegisterRequest& request) {
     if (request.protocol_version() != rpc::kProtocolVersion || request.program_version() != VRL_VERSION)
         throw ServiceError(ErrorKind::FailedPrecondition,
-                           "version mismatch: the worker runs vrlcuts " + request.program_version() +
+                           "version mismatch: the worker runs vrlcuts " + rpc::abbreviate(request.program_version()) +
                                " (protocol " + std::to_string(request.protocol_version()) +
                                ") but this coordinator runs vrlcuts " + VRL_VERSION + " (protocol " +
                                std::to_string(rpc::kProtocolVersion) + "); run workers of the coordinator's release");
@@ -485,6 +516,7 @@ v1::RegisterReply Coordinator::registerWorker(const v1::RegisterRequest& request
 }
 
 v1::HeartbeatReply Coordinator::heartbeat(const std::string& workerId) {
+    requireWorkerId(workerId);
     std::lock_guard lock(mutex_);
     v1::HeartbeatReply reply;
     const auto it = workers_.find(workerId);
@@ -496,10 +528,12 @@ v1::HeartbeatReply Coordinator::heartbeat(const std::string& workerId) {
 
 v1::LeaseReply Coordinator::leaseTiles(const v1::LeaseRequest& request) {
     const auto start = Clock::now();
+    requireWorkerId(request.worker_id());
     std::lock_guard lock(mutex_);
     const auto worker = workers_.find(request.worker_id());
     if (worker == workers_.end())
-        throw ServiceError(ErrorKind::FailedPrecondition, "unknown worker '" + request.worker_id() + "'; register again");
+        throw ServiceError(ErrorKind::FailedPrecondition,
+                           "unknown worker '" + rpc::abbreviate(request.worker_id()) + "'; register again");
     worker->second.lastHeartbeat = Clock::now();
     v1::LeaseReply reply;
     reply.set_draining(draining_);
@@ -544,6 +578,7 @@ v1::LeaseReply Coordinator::leaseTiles(const v1::LeaseRequest& request) {
 }
 
 std::shared_ptr<const std::string> Coordinator::asset(const std::string& sha256) const {
+    requireHash(sha256, "sha256");
     std::lock_guard lock(mutex_);
     const auto it = assets_.find(sha256);
     if (it == assets_.end()) throw ServiceError(ErrorKind::NotFound, "no live job uses asset " + sha256);
@@ -551,23 +586,36 @@ std::shared_ptr<const std::string> Coordinator::asset(const std::string& sha256)
 }
 
 std::string Coordinator::applyTile(Job& job, const v1::TileResult& result, bool replay) {
+    if (!(result.seconds() >= 0.0 && std::isfinite(result.seconds())))
+        return "seconds must be finite and >= 0, got " + std::to_string(result.seconds());
     const auto& t = result.tile();
     const auto at = job.tileAt.find({int(t.x0()), int(t.y0())});
-    if (at == job.tileAt.end()) return "not a tile of this job";
+    if (at == job.tileAt.end())
+        return "tile (" + std::to_string(t.x0()) + ", " + std::to_string(t.y0()) + ") is not a tile of this job's " +
+               std::to_string(job.width) + "x" + std::to_string(job.height) + " image";
     const uint32_t tile = at->second;
     const TileRect& rect = job.tiles[tile];
-    if (int(t.x1()) != rect.x1 || int(t.y1()) != rect.y1) return "tile bounds differ from the job's tiling";
+    if (t.x1() != uint32_t(rect.x1) || t.y1() != uint32_t(rect.y1))
+        return "tile bounds [" + std::to_string(t.x0()) + ", " + std::to_string(t.x1()) + ") x [" +
+               std::to_string(t.y0()) + ", " + std::to_string(t.y1()) + ") differ from the job's tiling";
     if (job.done[tile]) {
         ++statistics_.duplicatesDropped;
         return "duplicate: this tile was already accepted";
     }
-    if (size_t(result.layers_size()) != job.layers.size()) return "wrong number of layers";
+    if (size_t(result.layers_size()) != job.layers.size())
+        return "wrong number of layers: " + std::to_string(result.layers_size()) + ", expected " +
+               std::to_string(job.layers.size());
     const size_t floats = size_t(rect.width()) * rect.height() * 3;
     for (int l = 0; l < result.layers_size(); ++l) {
         const auto& layer = result.layers(l);
         const std::string& expected = l == 0 ? std::string() : job.layerNames[size_t(l - 1)];
-        if (layer.name() != expected) return "layer " + std::to_string(l) + " is '" + layer.name() + "', expected '" + expected + "'";
-        if (layer.rgb().size() != floats * sizeof(float)) return "layer '" + layer.name() + "' has the wrong size";
+        if (layer.name() != expected)
+            return "layer " + std::to_string(l) + " is '" + rpc::abbreviate(layer.name()) + "', expected '" + expected +
+                   "'";
+        if (layer.rgb().size() != floats * sizeof(float))
+            return "layer '" + layer.name() + "' has the wrong size: " + std::to_string(layer.rgb().size()) +
+                   " bytes, expected " + std::to_string(floats * sizeof(float)) + " (" + std::to_string(rect.width()) +
+                   "x" + std::to_string(rect.height()) + " RGB float32)";
         for (size_t i = 0; i < floats; ++i) {
             float v;
             std::memcpy(&v, layer.rgb().data() + i * sizeof(float), sizeof v);
@@ -603,15 +651,16 @@ std::string Coordinator::applyTile(Job& job, const v1::TileResult& result, bool 
     return {};
 }
 
-v1::SubmitTileReply Coordinator::submitTile(const v1::TileResult& result) {
+v1::SubmitTileReply Coordinator::submitTile(const v1::TileResult& result, bool* malformed) {
     const auto start = Clock::now();
+    if (malformed) *malformed = false;
+    requireWorkerId(result.worker_id());
     std::lock_guard lock(mutex_);
     v1::SubmitTileReply reply;
-    const auto jobIt = jobs_.find(result.job_id());
-    if (jobIt == jobs_.end()) throw ServiceError(ErrorKind::NotFound, "no job '" + result.job_id() + "'");
-    Job& job = *jobIt->second;
+    Job& job = findJob(result.job_id());
     if (!workers_.count(result.worker_id()))
-        throw ServiceError(ErrorKind::FailedPrecondition, "unknown worker '" + result.worker_id() + "'; register again");
+        throw ServiceError(ErrorKind::FailedPrecondition,
+                           "unknown worker '" + rpc::abbreviate(result.worker_id()) + "'; register again");
     // The lease counts only if it is this worker's lease on this job's tile.
     auto leaseIt = leases_.find(result.lease_id());
     if (leaseIt != leases_.end()) {
@@ -626,7 +675,16 @@ v1::SubmitTileReply Coordinator::submitTile(const v1::TileResult& result) {
         reply.set_reason("job is " + v1::JobState_Name(job.state));
         return reply;
     }
-    const std::string refused = applyTile(job, result, false);
+    std::string refused;
+    if (leaseIt == leases_.end()) {  // no live lease: a late result still counts, one for a lease never issued not
+        const auto at = job.tileAt.find({int(result.tile().x0()), int(result.tile().y0())});
+        if (at != job.tileAt.end() && !leaseWasIssued(result.lease_id(), job.id, at->second, nextLease_))
+            refused = result.lease_id().empty() ? "lease_id is required"
+                                                : "lease '" + rpc::abbreviate(result.lease_id()) +
+                                                      "' was never issued for tile " + std::to_string(at->second) +
+                                                      " of this job";
+    }
+    if (refused.empty()) refused = applyTile(job, result, false);
     if (refused.empty()) {
         reply.set_accepted(true);
         ++statistics_.tilesAccepted;
@@ -636,6 +694,7 @@ v1::SubmitTileReply Coordinator::submitTile(const v1::TileResult& result) {
     } else {
         reply.set_reason(refused);
         if (refused.rfind("duplicate", 0) != 0) {
+            if (malformed) *malformed = true;
             ++statistics_.tilesRejected;
             spdlog::warn("{}: tile result from {} refused: {}", job.id, result.worker_id(), refused);
             if (leaseIt != leases_.end()) {
@@ -673,6 +732,8 @@ void Coordinator::requeue(const std::string& leaseId, bool front) {
 }
 
 void Coordinator::releaseLeases(const v1::ReleaseRequest& request) {
+    requireWorkerId(request.worker_id());
+    const std::string failure = rpc::abbreviate(request.failure(), 1024);
     std::lock_guard lock(mutex_);
     for (const auto& id : request.lease_ids()) {
         const auto it = leases_.find(id);
@@ -682,7 +743,7 @@ void Coordinator::releaseLeases(const v1::ReleaseRequest& request) {
         requeue(id, request.failure().empty());
         if (!request.failure().empty())
             if (const auto job = jobs_.find(jobId); job != jobs_.end())
-                countFailure(*job->second, tile, "a worker could not shade it: " + request.failure());
+                countFailure(*job->second, tile, "a worker could not shade it: " + failure);
     }
 }
 

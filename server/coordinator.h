@@ -8,8 +8,8 @@
 // heartbeats stopped, goes back to the queue; a tile's first valid result is
 // merged (even a late one, if the tile is still missing: the pixels are the
 // same), any later one is dropped, never merged twice; results are checked
-// (registered worker, tile, layers, sizes, finite values) before they are
-// accepted. A tile refused or given up maxTileRejections times fails its job.
+// (registered worker, a lease issued for the tile, tile, layers, sizes, finite
+// values) before they are accepted. A tile refused or given up maxTileRejections times fails its job.
 //
 // What survives a restart (same --state-dir): uploaded bundles, every job's
 // spec, finished jobs (their EXR and record), and the accepted tiles of
@@ -86,7 +86,9 @@ public:
     v1::LeaseReply leaseTiles(const v1::LeaseRequest& request);
     // A blob a worker needs (bundle or lights) by SHA-256; NotFound if no live job uses it.
     std::shared_ptr<const std::string> asset(const std::string& sha256) const;
-    v1::SubmitTileReply submitTile(const v1::TileResult& result);
+    // A refused result (accepted false) sets `malformed` unless it was a duplicate or its job is no longer
+    // rendering: the gRPC front answers those with INVALID_ARGUMENT.
+    v1::SubmitTileReply submitTile(const v1::TileResult& result, bool* malformed = nullptr);
     void releaseLeases(const v1::ReleaseRequest& request);
 
     // --- shutdown: lease nothing more; outstanding leases still complete.

@@ -85,6 +85,7 @@ public:
                 if (first) {
                     sha256 = chunk.sha256();
                     total = chunk.total_size();
+                    (void)c_.hasBundle(sha256);  // refuses a missing or malformed hash before reading the rest
                     if (total > limit)
                         return {grpc::StatusCode::RESOURCE_EXHAUSTED,
                                 "scene bundle of " + std::to_string(total) + " bytes exceeds the limit of " +
@@ -206,9 +207,11 @@ public:
 
     grpc::Status SubmitTile(grpc::ServerContext* context, const v1::TileResult* request,
                             v1::SubmitTileReply* reply) override {
-        return guardedWorker(context, [&] {
-            *reply = c_.submitTile(*request);
-            return grpc::Status::OK;
+        return guardedWorker(context, [&]() -> grpc::Status {
+            bool malformed = false;
+            *reply = c_.submitTile(*request, &malformed);
+            if (malformed) return {grpc::StatusCode::INVALID_ARGUMENT, "tile result refused: " + reply->reason()};
+            return grpc::Status::OK;  // taken, or dropped as a duplicate or for a job no longer rendering
         });
     }
 

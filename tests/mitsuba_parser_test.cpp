@@ -1854,5 +1854,25 @@ TEST(MitsubaParserErrors, StrayDollarSign) {
                          {"bad.xml:2:", "'$'"}));
 }
 
+// Found by fuzzing: nested plugins recursed without limit (a stack overflow at
+// about 10,000 levels). Nesting beyond kMaxXmlDepth is a SceneError with a line.
+TEST(MitsubaParserHostile, DeeplyNestedElementsAreRefused) {
+    std::string xml = "<scene version=\"0.6.0\">\n";
+    for (int i = 0; i < 200; ++i) xml += "<bsdf type=\"twosided\">";
+    for (int i = 0; i < 200; ++i) xml += "</bsdf>";
+    xml += "\n</scene>\n";
+    const std::string message = errorOf(xml);
+    EXPECT_NE(message.find("nested deeper than"), std::string::npos) << message;
+    EXPECT_NE(message.find("bad.xml:2"), std::string::npos) << message;
+    // Nesting that real scenes use still parses.
+    std::string fine = "<scene version=\"0.6.0\">\n";
+    for (int i = 0; i < 8; ++i) fine += "<integrator type=\"adaptive\">";
+    fine += "<integrator type=\"volpath\"/>";
+    for (int i = 0; i < 8; ++i) fine += "</integrator>";
+    fine += "\n</scene>\n";
+    EXPECT_NO_THROW(parseMitsubaSceneString(fine, fixtureDir(), {}, "fine.xml"));
+}
+
 }  // namespace
 }  // namespace vrl
+

@@ -93,5 +93,27 @@ TEST(Renderer, ImageIsFiniteAndNonNegative) {
     }
 }
 
+// Lights from a blob must belong to the scene: a medium index out of range is
+// refused before shading could index out of bounds.
+TEST(Renderer, LightsNamingMissingMediaAreRefused) {
+    const auto scene = Scene::build(test::mediumOnlyCube(Rgb(1.0f), Rgb(0.0f), 0.0f));
+    RenderSettings settings;
+    settings.method = "vrl";
+    RenderLights lights;
+    lights.vrls.vrls.push_back(Vrl{Vec3(0.0f), Vec3(1, 0, 0), 0.1f, Rgb(1.0f), 7});
+    lights.vrls.lightPaths = 1;
+    try {
+        TileShader shader(*scene, settings, lights);
+        FAIL() << "expected std::invalid_argument";
+    } catch (const std::invalid_argument& e) {
+        EXPECT_NE(std::string(e.what()).find("medium 7"), std::string::npos) << e.what();
+    }
+    settings.method = "vrl-lightcuts";
+    RenderLights treeLights;
+    treeLights.tree = LightTree::build({Vrl{Vec3(0.0f), Vec3(1, 0, 0), 0.1f, Rgb(1.0f), -3}});
+    EXPECT_THROW(TileShader(*scene, settings, treeLights), std::invalid_argument);
+}
+
 }  // namespace
 }  // namespace vrl
+

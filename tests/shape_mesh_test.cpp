@@ -530,5 +530,20 @@ TEST(ShapeMeshTest, SerializedErrorsAreSceneErrors) {
     expectSceneErrorNaming(s, "format id");
 }
 
+// Found by fuzzing: 3 * index overflowed int, so a huge index passed the bounds
+// check and read outside the vertex array. Each is refused, naming the mesh.
+TEST(ShapeMeshTest, HugeObjIndicesAreSceneErrors) {
+    auto s = shape(Kind::Obj);
+    s.where = {"room.xml", 12, "<shape type=\"obj\">"};
+    const std::string vertices = "v 0 0 0\nv 1 0 0\nv 0 1 0\nvn 0 0 1\nvt 0 0\n";
+    s.filename = scratchFile("huge-vertex.obj", vertices + "f 1 2 1431655766\n");
+    expectSceneErrorNaming(s, "huge-vertex.obj");
+    s.filename = scratchFile("huge-normal.obj", vertices + "f 1//1 2//1 3//715827883\n");
+    expectSceneErrorNaming(s, "huge-normal.obj");
+    s.filename = scratchFile("huge-texcoord.obj", vertices + "f 1/1 2/1 3/1073741825\n");
+    expectSceneErrorNaming(s, "huge-texcoord.obj");
+}
+
 }  // namespace
 }  // namespace vrl
+

@@ -102,6 +102,7 @@ std::string hashSceneAndSettings(const BenchmarkScene& s, const std::string& set
     options.onFileReferenced = [&](const fs::path& f) { files.push_back(f); };
     (void)parseMitsubaScene(s.file, options);
     std::string all = settings;
+    for (const auto& [name, value] : s.defines) all += "\n-D " + name + "=" + value;
     for (const auto& f : files) {
         std::ifstream in(f, std::ios::binary);
         std::ostringstream bytes;
