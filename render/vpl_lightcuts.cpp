@@ -1,11 +1,11 @@
 #include "render/vpl_lightcuts.h"
 
+#include "render/cut_walk.h"
 #include "render/scene.h"
 
 #include <algorithm>
 #include <cmath>
 #include <limits>
-#include <queue>
 #include <stdexcept>
 #include <vector>
 
@@ -77,60 +77,25 @@ Rgb VplLightcutsEstimator::bound(int32_t index, const Vec3& x, int medium) const
 
 Rgb VplLightcutsEstimator::gather(const Vec3& x, const Vec3& toCamera, int medium, CutStatistics& statistics) const {
     if (tree_.empty()) return Rgb(0.0f);
-    struct CutNode {
-        float bound;
-        int32_t node;
-        Rgb estimate;
-        bool operator<(const CutNode& o) const { return bound != o.bound ? bound < o.bound : node > o.node; }
-    };
-    std::priority_queue<CutNode> heap;
-    Rgb total(0.0f);
-    uint32_t leavesInCut = 0;
-    const auto& nodes = tree_.nodes();
-    const auto& vpls = tree_.vrls();
-    std::vector<int32_t> pending;
-    const auto addToCut = [&](int32_t first) {
-        pending.push_back(first);
-        while (!pending.empty()) {
-            const int32_t i = pending.back();
-            pending.pop_back();
-            const LightTreeNode& node = nodes[i];
-            const Vrl& representative = vpls[node.representative];
-            ++statistics.evaluated;
-            if (node.isLeaf()) {
-                total += vplContribution(representative, representative.flux, x, toCamera, medium);
-                ++leavesInCut;
-                continue;
-            }
-            const Rgb b = bound(i, x, medium);
-            if (!std::isfinite(b.x + b.y + b.z)) {  // x in the node's box: refine without estimating
-                --statistics.evaluated;
-                ++statistics.intersected;
-                pending.push_back(node.left);
-                pending.push_back(node.right);
-                continue;
-            }
-            const Rgb e = vplContribution(representative, node.clusterFlux, x, toCamera, medium);
-            ++statistics.boundedEstimates;
-            if (e.x > b.x || e.y > b.y || e.z > b.z) ++statistics.boundExceeded;
-            total += e;
-            const float key = luminance(b);
-            heap.push({key >= 0.0f ? key : std::numeric_limits<float>::infinity(), i, e});
+    struct Visitor {
+        const VplLightcutsEstimator& self;
+        const Vec3& x;
+        const Vec3& toCamera;
+        int medium;
+        Rgb leaf(int32_t i) const {
+            const Vrl& vpl = self.tree_.vrls()[self.tree_.nodes()[i].representative];
+            return self.vplContribution(vpl, vpl.flux, x, toCamera, medium);
+        }
+        bool bound(int32_t i, Rgb& b) const {  // x in the node's box: infinite
+            b = self.bound(i, x, medium);
+            return std::isfinite(b.x + b.y + b.z);
+        }
+        Rgb estimate(int32_t i) const {
+            const LightTreeNode& node = self.tree_.nodes()[i];
+            return self.vplContribution(self.tree_.vrls()[node.representative], node.clusterFlux, x, toCamera, medium);
         }
     };
-    addToCut(tree_.root());
-    while (!heap.empty()) {
-        const CutNode& top = heap.top();
-        if (top.bound <= settings_.errorThreshold * std::max(0.0f, luminance(total))) break;
-        if (heap.size() + leavesInCut >= settings_.maxCutSize) break;
-        const CutNode refined = top;
-        heap.pop();
-        total -= refined.estimate;
-        addToCut(nodes[refined.node].left);
-        addToCut(nodes[refined.node].right);
-    }
-    statistics.cutSize += uint32_t(heap.size()) + leavesInCut;
-    return Rgb(std::max(0.0f, total.x), std::max(0.0f, total.y), std::max(0.0f, total.z));
+    return walkCut(tree_, settings_, statistics, Visitor{*this, x, toCamera, medium});
 }
 
 Rgb integrateAlongSegment(const Scene& scene, const CameraSegment& segment, int distanceSamples, Rng& rng,
