@@ -6,14 +6,14 @@
 // threshold, their ratio, the relative RMSE between the two images and #Eval,
 // #Inter and cut size per pixel (the paper's Table 1). Timings are wall-clock,
 // one run each, on whatever cores TBB gets: compare ratios, not seconds.
-#include "render/cut.h"
-#include "render/image_metrics.h"
-#include "render/light_tracer.h"
-#include "render/light_tree.h"
-#include "render/mitsuba_parser.h"
-#include "render/scene.h"
-#include "render/vrl_integrator.h"
-#include "render/timing.h"
+#include "render/core/timing.h"
+#include "render/image/image_metrics.h"
+#include "render/integrators/transport_integrator.h"
+#include "render/lightcuts/light_tree.h"
+#include "render/lightcuts/vrl_cut.h"
+#include "render/scene/scene.h"
+#include "render/scene_io/mitsuba/mitsuba_parser.h"
+#include "render/vrl/light_tracer.h"
 
 #include <CLI/CLI.hpp>
 #include <tbb/parallel_for.h>
@@ -34,10 +34,10 @@ struct Shading {
 
 // Part (d) on every `stride`-th pixel in x and y (the others stay black).
 Shading shade(const Scene& scene, const VrlSet& vrls, const LightTree* tree, float error, int stride, uint64_t seed) {
-    VrlIntegratorSettings settings;
+    TransportIntegratorSettings settings;
     settings.transports = TransportSelection::parse("multiple");
     settings.cut.errorThreshold = error;
-    const VrlIntegrator integrator(scene, vrls, settings, tree);
+    const TransportIntegrator integrator(scene, vrls, settings, tree);
     const PerspectiveCamera& camera = scene.camera();
     Shading out;
     out.image = Image(camera.width(), camera.height());

@@ -8,10 +8,11 @@
 // download of the serialised tree, MB/s) and the coordinator's time per tile
 // in its lease and submit handlers. Wall-clock, one run each: compare ratios.
 #include "client/job_client.h"
-#include "proto/job_scene.h"
+#include "render/core/timing.h"
 #include "server/coordinator_service.h"
+#include "service/job/job_scene.h"
+#include "util/random_id.h"
 #include "worker/asset_fetcher.h"
-#include "render/timing.h"
 
 #include <CLI/CLI.hpp>
 #include <spdlog/spdlog.h>
@@ -29,6 +30,7 @@
 extern char** environ;
 
 using namespace vrl;
+using namespace vrl::client;
 namespace fs = std::filesystem;
 
 namespace {
@@ -48,7 +50,7 @@ pid_t spawnWorker(const std::string& program, const std::string& address, int th
 // A coordinator serving on 127.0.0.1:<free port> with a temporary state directory.
 struct LoopbackCoordinator {
     explicit LoopbackCoordinator(const std::string& token)
-        : state(fs::temp_directory_path() / ("vrl-service-bench-" + rpc::randomHex(12))),
+        : state(fs::temp_directory_path() / ("vrl-service-bench-" + util::randomHex(12))),
           coordinator(optionsFor(state)),
           server(coordinator, server::ServerOptions{"127.0.0.1:0", {}, token}),
           address("127.0.0.1:" + std::to_string(server.port())) {}
@@ -92,7 +94,7 @@ int main(int argc, char** argv) {
     const auto x = resolution.find('x');
     v1::JobSpec spec;
     auto& p = *spec.mutable_parameters();
-    p = rpc::defaultRenderParameters(method);
+    p = rpc::defaultRenderParameters(parseRenderMethod(method));
     p.set_samples_per_pixel(spp);
     p.set_width(uint32_t(std::stoi(resolution.substr(0, x))));
     p.set_height(uint32_t(std::stoi(resolution.substr(x + 1))));
@@ -113,7 +115,7 @@ int main(int argc, char** argv) {
     std::printf("%-22s %10s %10s %12s %12s\n", "run", "total s", "shading s", "efficiency", "overhead/tile");
     std::printf("%-22s %10.3f %10.3f %12s %12s\n", "embedded", embeddedTotal, embeddedShading, "1.000", "-");
 
-    const std::string token = rpc::randomHex(32);
+    const std::string token = util::randomHex(32);
     setenv("VRL_TOKEN", token.c_str(), 1);  // the worker processes read it
     for (const int count : workerCounts) {
         {

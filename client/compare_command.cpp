@@ -1,13 +1,15 @@
 #include "client/commands.h"
 
-#include "render/exr_io.h"
-#include "render/image_metrics.h"
+#include "render/image/exr_io.h"
+#include "render/image/image_metrics.h"
 
 #include <cstdio>
 #include <cstring>
 #include <memory>
+#include <set>
+#include <string>
 
-namespace vrl {
+namespace vrl::client {
 
 void registerCompareCommand(CLI::App& app, int& exitCode) {
     auto* cmd = app.add_subcommand("compare", "Compare an image with a reference: RMSE, relative RMSE, SMAPE on luminance");
@@ -16,6 +18,10 @@ void registerCompareCommand(CLI::App& app, int& exitCode) {
     cmd->add_flag("--exact", *exact,
                   "Also require bit-identical pixels in the image and every layer (same layer names); exit 1 "
                   "otherwise. Metadata (timings) is ignored.");
+    auto metadata = std::make_shared<bool>(false);
+    cmd->add_flag("--metadata", *metadata,
+                  "Also require the same metadata keys and values, apart from timings (vrl.time.*) and how the "
+                  "render ran (vrl.run.*: threads, workers, job id); prints each difference; exit 1 otherwise.");
     cmd->add_option("reference", paths->first, "Reference EXR image")->required()->check(CLI::ExistingFile);
     cmd->add_option("image", paths->second, "EXR image to evaluate")->required()->check(CLI::ExistingFile);
     cmd->footer(
@@ -25,7 +31,7 @@ void registerCompareCommand(CLI::App& app, int& exitCode) {
         "  SMAPE         = (2/n) sum |R - I| / (R + I + 0.01)   (Vibert et al. 2019)\n"
         "  mean luminance of the image, of the reference, and their ratio\n"
         "Exits 1 when the sizes differ or a file cannot be read.");
-    cmd->callback([paths, exact, &exitCode] {
+    cmd->callback([paths, exact, metadata, &exitCode] {
         try {
             const ImageSet reference = readExr(paths->first);
             const ImageSet image = readExr(paths->second);
@@ -65,6 +71,32 @@ void registerCompareCommand(CLI::App& app, int& exitCode) {
                     std::printf("identical      yes (image and %zu layers, bit for bit)\n", reference.layers.size());
                 }
             }
+            if (*metadata) {
+                const auto compared = [](const std::string& key) {
+                    return key.rfind("vrl.time.", 0) != 0 && key.rfind("vrl.run.", 0) != 0;
+                };
+                size_t differences = 0, keys = 0;
+                std::set<std::string> all;
+                for (const auto& [key, value] : reference.metadata) all.insert(key);
+                for (const auto& [key, value] : image.metadata) all.insert(key);
+                for (const auto& key : all) {
+                    if (!compared(key)) continue;
+                    ++keys;
+                    const auto a = reference.metadata.find(key), b = image.metadata.find(key);
+                    if (a != reference.metadata.end() && b != image.metadata.end() && a->second == b->second) continue;
+                    ++differences;
+                    std::printf("metadata       %s: %s vs %s\n", key.c_str(),
+                                a == reference.metadata.end() ? "(absent)" : metadataText(a->second).c_str(),
+                                b == image.metadata.end() ? "(absent)" : metadataText(b->second).c_str());
+                }
+                if (differences > 0) {
+                    std::printf("same metadata  no (%zu of %zu keys differ; vrl.time.* and vrl.run.* not compared)\n",
+                                differences, keys);
+                    exitCode = 1;
+                } else {
+                    std::printf("same metadata  yes (%zu keys; vrl.time.* and vrl.run.* not compared)\n", keys);
+                }
+            }
         } catch (const std::exception& e) {
             std::fprintf(stderr, "vrl compare: error: %s\n", e.what());
             exitCode = 1;
@@ -72,4 +104,4 @@ void registerCompareCommand(CLI::App& app, int& exitCode) {
     });
 }
 
-}  // namespace vrl
+}  // namespace vrl::client

@@ -1,11 +1,13 @@
 #include "client/job_client.h"
 
-#include "proto/scene_bundle.h"
-#include "render/mitsuba_parser.h"
+#include "render/scene_io/mitsuba/mitsuba_parser.h"
+#include "service/job/scene_bundle.h"
+#include "util/atomic_file.h"
+#include "util/hash.h"
 
 #include <fstream>
 
-namespace vrl {
+namespace vrl::client {
 
 namespace {
 
@@ -21,7 +23,7 @@ JobClient::JobClient(const std::string& address, const rpc::TlsOptions& tls, std
     : channel_(rpc::makeChannel(address, tls)), stub_(v1::JobService::NewStub(channel_)), token_(std::move(token)) {}
 
 std::string JobClient::uploadBundle(const std::string& blob, bool* uploaded) {
-    const std::string sha256 = rpc::sha256Hex(blob);
+    const std::string sha256 = util::sha256Hex(blob);
     {
         grpc::ClientContext context;
         rpc::prepareContext(context, token_, 30s);
@@ -46,7 +48,7 @@ std::string JobClient::uploadBundle(const std::string& blob, bool* uploaded) {
         }
         chunk.set_offset(offset);
         chunk.set_data(blob.data() + offset, size);
-        chunk.set_crc32(rpc::crc32Of(chunk.data()));
+        chunk.set_crc32(util::crc32Of(chunk.data()));
         if (!writer->Write(chunk)) break;  // the server ended the call; Finish says why
         offset += size;
     } while (offset < blob.size());
@@ -100,21 +102,15 @@ void JobClient::fetchImage(const std::string& jobId, const std::filesystem::path
             total = chunk.total_size();
             sha256 = chunk.sha256();
         }
-        if (chunk.offset() != blob.size() || rpc::crc32Of(chunk.data()) != chunk.crc32())
+        if (chunk.offset() != blob.size() || util::crc32Of(chunk.data()) != chunk.crc32())
             throw JobClientError("FetchImage: a corrupt chunk at offset " + std::to_string(chunk.offset()),
                                  grpc::StatusCode::DATA_LOSS);
         blob += chunk.data();
     }
     check(reader->Finish(), "FetchImage");
-    if (blob.size() != total || rpc::sha256Hex(blob) != sha256)
+    if (blob.size() != total || util::sha256Hex(blob) != sha256)
         throw JobClientError("FetchImage: the image arrived incomplete or corrupt", grpc::StatusCode::DATA_LOSS);
-    const std::filesystem::path temporary = path.string() + ".partial";
-    {
-        std::ofstream out(temporary, std::ios::binary | std::ios::trunc);
-        out.write(blob.data(), std::streamsize(blob.size()));
-        if (!out) throw std::runtime_error("cannot write '" + temporary.string() + "'");
-    }
-    std::filesystem::rename(temporary, path);
+    util::writeFileAtomically(path, blob);
 }
 
 v1::JobState JobClient::cancel(const std::string& jobId) {
@@ -144,4 +140,4 @@ std::string collectSceneBundle(const std::filesystem::path& scene, const std::ma
     return rpc::makeBundleBlob(scene, files);
 }
 
-}  // namespace vrl
+}  // namespace vrl::client

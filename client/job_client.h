@@ -2,7 +2,7 @@
 // submit, watch, fetch the EXR, cancel, list), with a deadline on every call.
 #pragma once
 
-#include "proto/rpc_common.h"
+#include "service/common/rpc_common.h"
 #include "vrl/v1/vrl.grpc.pb.h"
 
 #include <filesystem>
@@ -12,7 +12,7 @@
 #include <string>
 #include <vector>
 
-namespace vrl {
+namespace vrl::client {
 
 // A call the coordinator refused or that failed; the message names the call and the status.
 struct JobClientError : std::runtime_error {
@@ -45,4 +45,4 @@ private:
 // parsing it with `defines`, as a bundle blob. Throws SceneError or BundleError.
 std::string collectSceneBundle(const std::filesystem::path& scene, const std::map<std::string, std::string>& defines);
 
-}  // namespace vrl
+}  // namespace vrl::client

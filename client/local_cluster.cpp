@@ -1,6 +1,7 @@
 #include "client/local_cluster.h"
 
-#include "proto/rpc_common.h"
+#include "service/common/rpc_common.h"
+#include "util/random_id.h"
 
 #include <signal.h>
 #include <spawn.h>
@@ -15,7 +16,7 @@
 
 extern char** environ;
 
-namespace vrl {
+namespace vrl::client {
 
 namespace fs = std::filesystem;
 using namespace std::chrono_literals;
@@ -44,8 +45,8 @@ pid_t LocalCluster::spawn(const std::vector<std::string>& arguments) {
 }
 
 LocalCluster::LocalCluster(int workers, int threadsPerWorker, const std::string& logLevel) {
-    token_ = rpc::randomHex(32);
-    stateDir_ = fs::temp_directory_path() / ("vrl-local-" + std::to_string(getpid()) + "-" + rpc::randomHex(8));
+    token_ = util::randomHex(32);
+    stateDir_ = fs::temp_directory_path() / ("vrl-local-" + std::to_string(getpid()) + "-" + util::randomHex(8));
     fs::create_directories(stateDir_);
     const fs::path portFile = stateDir_ / "port";
     processes_.emplace_back("coordinator", spawn({"vrl", "coordinator", "--listen", "127.0.0.1:0", "--state-dir",
@@ -114,4 +115,4 @@ LocalCluster::~LocalCluster() {
     fs::remove_all(stateDir_, error);
 }
 
-}  // namespace vrl
+}  // namespace vrl::client

@@ -9,7 +9,7 @@
 #include <sys/types.h>
 #include <vector>
 
-namespace vrl {
+namespace vrl::client {
 
 class LocalCluster {
 public:
@@ -32,4 +32,4 @@ private:
     std::vector<std::pair<std::string, pid_t>> processes_;  // coordinator first
 };
 
-}  // namespace vrl
+}  // namespace vrl::client

@@ -4,7 +4,7 @@
 
 #include <cstdio>
 
-namespace vrl {
+namespace vrl::client {
 
 ProgressBar::ProgressBar(std::string label)
     : label_(std::move(label)), terminal_(isatty(STDERR_FILENO) != 0), start_(std::chrono::steady_clock::now()) {}
@@ -42,4 +42,4 @@ void ProgressBar::finish() {
     finished_ = true;
 }
 
-}  // namespace vrl
+}  // namespace vrl::client

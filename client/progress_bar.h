@@ -6,7 +6,7 @@
 #include <mutex>
 #include <string>
 
-namespace vrl {
+namespace vrl::client {
 
 class ProgressBar {
 public:
@@ -25,4 +25,4 @@ private:
     std::chrono::steady_clock::time_point start_;
 };
 
-}  // namespace vrl
+}  // namespace vrl::client

@@ -2,9 +2,9 @@
 
 #include "client/job_client.h"
 #include "client/progress_bar.h"
-#include "render/exr_io.h"
-#include "render/preview_image.h"
-#include "render/timing.h"
+#include "render/core/timing.h"
+#include "render/image/exr_io.h"
+#include "render/image/preview_image.h"
 
 #include <spdlog/spdlog.h>
 
@@ -12,22 +12,16 @@
 #include <cstdio>
 #include <memory>
 
-namespace vrl {
+namespace vrl::client {
 
 int runRemoteRender(const RenderCommandOptions& o, const RemoteOptions& remote) {
     const auto start = std::chrono::steady_clock::now();
     JobClient client(remote.address, remote.tls, remote.token);
     std::string jobId = remote.attachJob;
     if (jobId.empty()) {
-        v1::JobSpec spec;
-        const auto defines = parseDefines(o.defines);
-        spec.mutable_defines()->insert(defines.begin(), defines.end());
-        *spec.mutable_parameters() = toRenderParameters(o);
-        spec.set_tile_size(o.tileSize);
+        v1::JobSpec spec = makeJobSpec(o);
         spec.set_priority(remote.priority);
-        spec.set_name(o.scene);
-        spec.set_medium(o.medium);
-        const std::string blob = collectSceneBundle(o.scene, defines);
+        const std::string blob = collectSceneBundle(o.scene, parseDefines(o.defines));
         bool uploaded = false;
         spec.set_bundle_sha256(client.uploadBundle(blob, &uploaded));
         spdlog::info("scene bundle {} ({} bytes) {}", spec.bundle_sha256().substr(0, 12), blob.size(),
@@ -82,4 +76,4 @@ int runRemoteRender(const RenderCommandOptions& o, const RemoteOptions& remote) 
     return 0;
 }
 
-}  // namespace vrl
+}  // namespace vrl::client

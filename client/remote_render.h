@@ -4,11 +4,11 @@
 #pragma once
 
 #include "client/render_options.h"
-#include "proto/rpc_common.h"
+#include "service/common/rpc_common.h"
 
 #include <string>
 
-namespace vrl {
+namespace vrl::client {
 
 struct RemoteOptions {
     std::string address;
@@ -22,4 +22,4 @@ struct RemoteOptions {
 // Returns the process exit code (0 done, 1 failed/cancelled/unreachable, 2 refused input).
 int runRemoteRender(const RenderCommandOptions& o, const RemoteOptions& remote);
 
-}  // namespace vrl
+}  // namespace vrl::client

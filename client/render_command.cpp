@@ -4,16 +4,16 @@
 #include "client/progress_bar.h"
 #include "client/remote_render.h"
 #include "client/render_options.h"
-#include "proto/scene_bundle.h"
+#include "service/job/job_scene.h"
+#include "service/job/scene_bundle.h"
 
-#include "render/exr_io.h"
-#include "render/medium_fill.h"
-#include "render/preview_image.h"
-#include "render/mitsuba_parser.h"
+#include "render/core/timing.h"
+#include "render/image/exr_io.h"
+#include "render/image/preview_image.h"
+#include "render/render_metadata.h"
 #include "render/renderer.h"
-#include "render/scene.h"
-#include "render/vrl.h"
-#include "render/timing.h"
+#include "render/scene/scene.h"
+#include "render/vrl/vrl.h"
 
 #include <spdlog/spdlog.h>
 #include <sys/resource.h>
@@ -26,9 +26,8 @@
 #include <cstdio>
 #include <memory>
 #include <mutex>
-#include <regex>
 
-namespace vrl {
+namespace vrl::client {
 
 namespace {
 
@@ -83,61 +82,17 @@ int runRender(const RenderCommandOptions& o) {
     if (o.quiet) spdlog::set_level(spdlog::level::warn);
     if (o.workers > 0) return runLocalCluster(o);
     using Clock = std::chrono::steady_clock;
-    ParseOptions parseOptions;
-    for (const auto& d : o.defines) {
-        const auto eq = d.find('=');
-        if (eq == std::string::npos || eq == 0) {
-            std::fprintf(stderr, "vrl render: error: -D expects name=value, got '%s'\n", d.c_str());
-            return 2;
-        }
-        parseOptions.defines[d.substr(0, eq)] = d.substr(eq + 1);
-    }
 
+    // The same builder as the coordinator's (service/job/job_scene.h), with the
+    // command line's own VRL limit in place of a coordinator's.
     auto t0 = Clock::now();
-    SceneDescription description = parseMitsubaScene(o.scene, parseOptions);
-    if (!o.medium.empty()) {
-        try {
-            fillWithMedium(description, parseFillMedium(o.medium));
-        } catch (const std::invalid_argument& e) {
-            std::fprintf(stderr, "vrl render: error: %s\n", e.what());
-            return 2;
-        }
-    }
-    if (!o.resolution.empty()) {
-        std::smatch match;
-        const std::regex pattern("^([0-9]{1,9})x([0-9]{1,9})$");
-        if (!std::regex_match(o.resolution, match, pattern)) {
-            std::fprintf(stderr, "vrl render: error: --resolution expects WxH (e.g. 640x480), got '%s'\n",
-                         o.resolution.c_str());
-            return 2;
-        }
-        description.sensor.width = std::stoi(match[1]);
-        description.sensor.height = std::stoi(match[2]);
-    }
+    const v1::JobSpec spec = makeJobSpec(o);
+    rpc::ServiceLimits limits;
+    limits.maxVrls = uint64_t(1) << 40;
+    rpc::ResolvedJob job = rpc::resolveJob(o.scene, spec, limits);
+    const SceneDescription& description = job.description;
+    const RenderSettings& settings = job.settings;
     const auto& sensor = description.sensor;
-    if (sensor.width < 1 || sensor.height < 1 || sensor.width > kMaxFilmSide || sensor.height > kMaxFilmSide ||
-        (long long)sensor.width * sensor.height > kMaxFilmPixels) {
-        std::fprintf(stderr,
-                     "vrl render: error: resolution %dx%d is outside the supported range (1..%d per side, at most "
-                     "%lld pixels)\n",
-                     sensor.width, sensor.height, kMaxFilmSide, kMaxFilmPixels);
-        return 2;
-    }
-    RenderSettings settings;
-    settings.method = o.method;
-    settings.samplesPerPixel = o.spp > 0 ? o.spp : sensor.sampleCount;
-    settings.seed = o.seed;
-    settings.jitter = o.jitter;
-    settings.maxDepth = o.maxDepth >= -1 ? o.maxDepth : description.integrator.maxDepth;
-    settings.transports = TransportSelection::parse(o.transport);
-    settings.vrlCount = o.vrls;
-    settings.lightPaths = o.lightPaths;
-    settings.vrlSamples = o.vrlSamples;
-    settings.cut.errorThreshold = o.error;
-    settings.cut.maxCutSize = o.maxCut;
-    settings.cut.bound.exactDistanceBelow = o.exactDistanceBelow;
-    settings.cut.bound.anisotropyEpsilon = o.hgEpsilon;
-    settings.partitionSize = o.partitionSize;
     const double parseSeconds = secondsSince(t0);
 
     t0 = Clock::now();
@@ -167,37 +122,16 @@ int runRender(const RenderCommandOptions& o) {
     if (bar) bar->finish();
 
     t0 = Clock::now();
-    images.metadata["vrl.version"] = VRL_VERSION;
-    images.metadata["vrl.scene"] = o.scene;
-    images.metadata["vrl.method"] = settings.method;
-    images.metadata["vrl.spp"] = std::to_string(settings.samplesPerPixel);
-    images.metadata["vrl.seed"] = std::to_string(settings.seed);
-    images.metadata["vrl.maxDepth"] = std::to_string(settings.maxDepth);
-    images.metadata["vrl.jitter"] = settings.jitter ? "true" : "false";
-    images.metadata["vrl.threads"] = std::to_string(threads);
-    std::string defines;
-    for (const auto& d : o.defines) defines += (defines.empty() ? "" : " ") + d;
-    images.metadata["vrl.defines"] = defines;
-    addSceneNotes(description, images.metadata);
-    if (!o.medium.empty()) images.metadata["vrl.medium"] = o.medium;
-    images.metadata["vrl.time.parse"] = std::to_string(parseSeconds);
-    images.metadata["vrl.time.build"] = std::to_string(buildSeconds);
-    images.metadata["vrl.time.render"] = std::to_string(stats.seconds);
-    if (usesLightTree(settings.method)) {
-        images.metadata["vrl.error"] = std::to_string(o.error);
-        images.metadata["vrl.maxCut"] = std::to_string(o.maxCut);
-        images.metadata["vrl.exactDistanceBelow"] = std::to_string(o.exactDistanceBelow);
-        images.metadata["vrl.hgEpsilon"] = std::to_string(o.hgEpsilon);
-        images.metadata["vrl.partitionSize"] = std::to_string(o.partitionSize);
-        images.metadata["vrl.time.treeBuild"] = std::to_string(stats.treeSeconds);
-    }
-    if (settings.method != "path") {
-        images.metadata["vrl.transport"] = settings.transports.toString();
-        images.metadata["vrl.vrlSamples"] = std::to_string(settings.vrlSamples);
-        images.metadata["vrl.vrlCount"] = std::to_string(stats.vrlCount);
-        images.metadata["vrl.lightPaths"] = std::to_string(stats.lightPaths);
-        images.metadata["vrl.time.lightTracing"] = std::to_string(stats.tracingSeconds);
-    }
+    RenderRecord record;
+    record.scene = o.scene;
+    record.defines.insert(spec.defines().begin(), spec.defines().end());
+    record.medium = o.medium;
+    record.sceneNotes = sceneNotes(description);
+    record.settings = settings;
+    record.statistics = stats;
+    record.phases = {{"parse", parseSeconds}, {"build", buildSeconds}};
+    record.run = {{"threads", int32_t(threads)}, {"workers", int32_t(0)}};
+    writeRenderMetadata(record, scene->camera(), images.metadata);
     writeExr(o.output, images);
     if (!o.preview.empty()) writePreviewPng(images.image, o.preview, autoExposure(images.image));
     const double writeSeconds = secondsSince(t0);
@@ -207,15 +141,16 @@ int runRender(const RenderCommandOptions& o) {
                  "  parse  %8.3f s\n  build  %8.3f s (%zu shapes, %zu media, %zu emitters)\n"
                  "  render %8.3f s (%llu camera samples, %.3g samples/s)\n  write  %8.3f s -> %s\n"
                  "  peak memory %.1f MiB\n",
-                 o.scene.c_str(), sensor.width, sensor.height, settings.method.c_str(), settings.samplesPerPixel,
+                 o.scene.c_str(), sensor.width, sensor.height, std::string(methodName(settings.method)).c_str(), settings.samplesPerPixel,
                  (unsigned long long)settings.seed, threads, parseSeconds, buildSeconds, scene->shapes().size(),
                  scene->media().size(), scene->emitters().size(), stats.seconds,
                  (unsigned long long)stats.cameraSamples,
                  stats.seconds > 0 ? double(stats.cameraSamples) / stats.seconds : 0.0, writeSeconds,
                  o.output.c_str(), peakMemoryMiB());
-    if (settings.method != "path") {
-        std::fprintf(stderr, "  light tracing %.3f s: %llu light paths -> %llu VRLs, %.1f MiB (%zu bytes each)\n",
+    if (usesVirtualLights(settings.method)) {
+        std::fprintf(stderr, "  light tracing %.3f s: %llu light paths -> %llu %s, %.1f MiB (%zu bytes each)\n",
                      stats.tracingSeconds, (unsigned long long)stats.lightPaths, (unsigned long long)stats.vrlCount,
+                     usesVpls(settings.method) ? "VPLs" : "VRLs",
                      double(stats.vrlBytes) / (1024.0 * 1024.0), sizeof(Vrl));
         std::fprintf(stderr, "  transport parts: %s\n", settings.transports.toString().c_str());
     }
@@ -248,6 +183,9 @@ void registerRenderCommand(CLI::App& app, int& exitCode) {
         } catch (const SceneError& e) {
             std::fprintf(stderr, "vrl render: scene error: %s\n", e.what());
             exitCode = 2;
+        } catch (const rpc::JobSpecError& e) {
+            std::fprintf(stderr, "vrl render: error: %s\n", e.what());
+            exitCode = 2;
         } catch (const rpc::BundleError& e) {
             std::fprintf(stderr, "vrl render: error: %s\n", e.what());
             exitCode = 2;
@@ -261,4 +199,4 @@ void registerRenderCommand(CLI::App& app, int& exitCode) {
     });
 }
 
-}  // namespace vrl
+}  // namespace vrl::client

@@ -1,12 +1,12 @@
 #include "client/render_options.h"
 
 #include "render/renderer.h"
-#include "render/scene_description.h"
+#include "render/scene/scene_description.h"
 
 #include <regex>
 #include <stdexcept>
 
-namespace vrl {
+namespace vrl::client {
 
 void addRenderOptions(CLI::App& cmd, RenderCommandOptions& o) {
     cmd.add_option("scene", o.scene, "Scene file (Mitsuba 0.5/0.6 XML subset)")->required();
@@ -25,7 +25,7 @@ void addRenderOptions(CLI::App& cmd, RenderCommandOptions& o) {
                     "(d) by cuts through a VRL light tree) or vpl-lightcuts (the paper's baseline: (d) by Lightcuts "
                     "over VPLs at the light paths' medium collisions, 32 stratified distance samples per camera "
                     "segment, no clamping; vpl: the same with every VPL gathered, no tree)")
-        ->check(CLI::IsMember(kRenderMethods));
+        ->check(CLI::IsMember(renderMethodNames()));
     cmd.add_option("--spp", o.spp, "Samples per pixel (default: the scene's sampler sampleCount)")
         ->check(CLI::Range(1, kMaxSampleCount));
     cmd.add_option("--resolution", o.resolution, "Image size WxH, overriding the scene's film (e.g. 640x480)");
@@ -47,7 +47,7 @@ void addRenderOptions(CLI::App& cmd, RenderCommandOptions& o) {
     cmd.add_option("--light-paths", o.lightPaths, "vrl: trace exactly this many light paths (overrides --vrls)")
         ->check(CLI::Range(uint64_t(1), uint64_t(1) << 40));
     cmd.add_option("--vrl-samples", o.vrlSamples, "vrl: (u, v) samples per VRL and camera segment (default 1)")
-        ->check(CLI::Range(1, 1 << 16));
+        ->check(CLI::Range(1, 1024));
     cmd.add_option("--transport", o.transport,
                     "vrl: parts to render, comma-separated: surface (a), single (b), medium-surface (c), multiple (d); "
                     "each is also written as an EXR layer (default: all four)");
@@ -118,4 +118,15 @@ v1::RenderParameters toRenderParameters(const RenderCommandOptions& o) {
     return p;
 }
 
-}  // namespace vrl
+v1::JobSpec makeJobSpec(const RenderCommandOptions& o) {
+    v1::JobSpec spec;
+    const auto defines = parseDefines(o.defines);
+    spec.mutable_defines()->insert(defines.begin(), defines.end());
+    *spec.mutable_parameters() = toRenderParameters(o);
+    spec.set_tile_size(o.tileSize);
+    spec.set_name(o.scene);
+    spec.set_medium(o.medium);
+    return spec;
+}
+
+}  // namespace vrl::client

@@ -11,7 +11,7 @@
 #include <string>
 #include <vector>
 
-namespace vrl {
+namespace vrl::client {
 
 struct RenderCommandOptions {
     std::string scene;
@@ -50,5 +50,9 @@ std::map<std::string, std::string> parseDefines(const std::vector<std::string>& 
 std::pair<int, int> parseResolution(const std::string& text);
 // The job's parameters (width/height 0 when no --resolution).
 v1::RenderParameters toRenderParameters(const RenderCommandOptions& o);
+// The whole job spec of the flags (name, defines, medium, parameters, tile
+// size; no bundle): what `vrl render` resolves in-process with
+// rpc::resolveJob and what `--workers` and `vrl submit` send.
+v1::JobSpec makeJobSpec(const RenderCommandOptions& o);
 
-}  // namespace vrl
+}  // namespace vrl::client

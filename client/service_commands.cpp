@@ -4,14 +4,14 @@
 #include "client/job_client.h"
 #include "client/remote_render.h"
 #include "grpc/health/v1/health.grpc.pb.h"
-#include "proto/scene_bundle.h"
-#include "render/scene_error.h"
+#include "render/scene/scene_error.h"
+#include "service/job/scene_bundle.h"
 
 #include <cstdio>
 #include <cstdlib>
 #include <memory>
 
-namespace vrl {
+namespace vrl::client {
 
 namespace {
 
@@ -147,4 +147,4 @@ void registerServiceCommands(CLI::App& app, int& exitCode) {
     }
 }
 
-}  // namespace vrl
+}  // namespace vrl::client

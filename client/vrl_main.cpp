@@ -16,9 +16,9 @@ int main(int argc, char** argv) {
     app.set_version_flag("--version", std::string("vrl ") + VRL_VERSION);
     app.require_subcommand(1);
     int exitCode = 0;
-    vrl::registerRenderCommand(app, exitCode);
-    vrl::registerCompareCommand(app, exitCode);
-    vrl::registerServiceCommands(app, exitCode);
+    vrl::client::registerRenderCommand(app, exitCode);
+    vrl::client::registerCompareCommand(app, exitCode);
+    vrl::client::registerServiceCommands(app, exitCode);
     app.footer("Also: `vrl coordinator --help` and `vrl worker --help` (the vrl-coordinator and vrl-worker programs).");
     spdlog::set_pattern("[%l] %v");
     try {

@@ -5,7 +5,7 @@
 #   cmake -C fuzz/clang-fuzz.cmake -S . -B build-fuzz && cmake --build build-fuzz
 # Another clang: add -DCMAKE_CXX_COMPILER=clang++-NN.
 set(CMAKE_CXX_COMPILER clang++ CACHE FILEPATH "C++ compiler (clang, with libFuzzer)")
-set(VRL_FUZZ_ONLY ON CACHE BOOL "Build only vrl_render, vrl_rpc, vrl_job and the fuzzers")
+set(VRL_FUZZ_ONLY ON CACHE BOOL "Build only vrl_util, vrl_render, vrl_proto, vrl_service_common, vrl_job and the fuzzers")
 set(VRL_BUILD_TESTS OFF CACHE BOOL "Build the test suite")
 # A build type of its own: -O1 -g with assertions on (no NDEBUG).
 set(CMAKE_BUILD_TYPE Fuzz CACHE STRING "Build type")

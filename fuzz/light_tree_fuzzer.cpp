@@ -12,7 +12,7 @@
 // data, which cannot happen here). Anything else is reported with
 // VRL_FUZZ_STRICT_EXCEPTIONS=1 (fuzz_common.h).
 #include "fuzz/fuzz_common.h"
-#include "render/light_tree_io.h"
+#include "render/lightcuts/light_tree_io.h"
 
 #include <zlib.h>
 

@@ -14,8 +14,8 @@
 // SceneError or std::runtime_error. Anything else is reported with
 // VRL_FUZZ_STRICT_EXCEPTIONS=1 (fuzz_common.h).
 #include "fuzz/fuzz_common.h"
-#include "proto/job_scene.h"
-#include "proto/scene_bundle.h"
+#include "service/job/job_scene.h"
+#include "service/job/scene_bundle.h"
 
 #include <google/protobuf/stubs/logging.h>
 
@@ -56,7 +56,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     try {
         const std::filesystem::path scene = vrl::rpc::extractBundle(bundle, directory);
         vrl::v1::JobSpec spec;
-        *spec.mutable_parameters() = vrl::rpc::defaultRenderParameters("path");
+        *spec.mutable_parameters() = vrl::rpc::defaultRenderParameters(vrl::RenderMethod::Path);
         const vrl::rpc::JobScene job = vrl::rpc::loadJobScene(directory, scene, spec, limits);
         vrl_fuzz::accepted("bundle extracted, scene built");
     } catch (const std::runtime_error& e) {  // SceneError, filesystem_error

@@ -12,9 +12,9 @@
 // vrl::SceneError or std::runtime_error (Embree). Anything else is reported
 // with VRL_FUZZ_STRICT_EXCEPTIONS=1 (fuzz_common.h).
 #include "fuzz/fuzz_common.h"
-#include "render/mitsuba_parser.h"
-#include "render/scene.h"
-#include "render/scene_error.h"
+#include "render/scene/scene.h"
+#include "render/scene/scene_error.h"
+#include "render/scene_io/mitsuba/mitsuba_parser.h"
 
 #include <cstddef>
 #include <cstdint>

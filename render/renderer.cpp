@@ -1,9 +1,9 @@
 #include "render/renderer.h"
 
-#include "render/light_tracer.h"
-#include "render/path_tracer.h"
-#include "render/vrl_integrator.h"
-#include "render/timing.h"
+#include "render/core/timing.h"
+#include "render/integrators/path_tracer.h"
+#include "render/integrators/transport_integrator.h"
+#include "render/vrl/light_tracer.h"
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
@@ -25,18 +25,36 @@ Ray cameraRay(const PerspectiveCamera& camera, const RenderSettings& settings, i
     return camera.generateRay(float(x) + jx, float(y) + jy);
 }
 
-bool isVrlMethod(const RenderSettings& settings) {
-    return settings.method == "vrl" || settings.method == "vpl" || usesLightTree(settings.method);
-}
+bool isVrlMethod(const RenderSettings& settings) { return usesVirtualLights(settings.method); }
 
 }  // namespace
 
-void validateRenderSettings(const RenderSettings& settings) {
-    if (std::find(kRenderMethods.begin(), kRenderMethods.end(), settings.method) == kRenderMethods.end()) {
-        std::string valid;
-        for (const auto& m : kRenderMethods) valid += (valid.empty() ? "" : ", ") + m;
-        throw std::invalid_argument("unknown method '" + settings.method + "' (valid: " + valid + ")");
+std::string_view methodName(RenderMethod method) {
+    switch (method) {
+        case RenderMethod::Path: return "path";
+        case RenderMethod::Vrl: return "vrl";
+        case RenderMethod::VrlLightcuts: return "vrl-lightcuts";
+        case RenderMethod::Vpl: return "vpl";
+        case RenderMethod::VplLightcuts: return "vpl-lightcuts";
     }
+    throw std::invalid_argument("unknown RenderMethod " + std::to_string(int(method)));
+}
+
+std::vector<std::string> renderMethodNames() {
+    std::vector<std::string> names;
+    for (RenderMethod m : kRenderMethods) names.emplace_back(methodName(m));
+    return names;
+}
+
+RenderMethod parseRenderMethod(std::string_view name) {
+    for (RenderMethod m : kRenderMethods)
+        if (methodName(m) == name) return m;
+    std::string valid;
+    for (RenderMethod m : kRenderMethods) valid += (valid.empty() ? "" : ", ") + std::string(methodName(m));
+    throw std::invalid_argument("unknown method '" + std::string(name.substr(0, 64)) + "' (valid: " + valid + ")");
+}
+
+void validateRenderSettings(const RenderSettings& settings) {
     if (settings.samplesPerPixel < 1) throw std::invalid_argument("samples per pixel must be at least 1");
     if (settings.vrlSamples < 1) throw std::invalid_argument("samples per VRL must be at least 1");
     if (!(settings.cut.errorThreshold >= 0.0f)) throw std::invalid_argument("the error threshold must be >= 0");
@@ -126,11 +144,11 @@ TileShader::TileShader(const Scene& scene, const RenderSettings& settings, const
     checkLightsMatchScene(scene, lights);
     if (isVrlMethod(settings)) {
         const bool lightcuts = usesLightTree(settings.method);
-        VrlIntegratorSettings integratorSettings{settings.transports, settings.maxDepth, settings.vrlSamples,
+        TransportIntegratorSettings integratorSettings{settings.transports, settings.maxDepth, settings.vrlSamples,
                                                  settings.cut};
         integratorSettings.vpls = usesVpls(settings.method);
         integratorSettings.vplDistanceSamples = settings.vplDistanceSamples;
-        integrator_ = std::make_unique<VrlIntegrator>(scene, lights.vrls, integratorSettings,
+        integrator_ = std::make_unique<TransportIntegrator>(scene, lights.vrls, integratorSettings,
                                                       lightcuts && lights.tree.root() >= 0 ? &lights.tree : nullptr);
     } else {
         tracer_ = std::make_unique<VolumetricPathTracer>(scene, PathTracerSettings{settings.maxDepth});

@@ -5,21 +5,25 @@
 // coordinator runs prepareLights once, workers run TileShader on leased tiles.
 #pragma once
 
-#include "render/cut.h"
-#include "render/image.h"
-#include "render/light_tree.h"
-#include "render/scene.h"
-#include "render/transport.h"
+#include "render/image/image.h"
+#include "render/integrators/transport_parts.h"
+#include "render/lightcuts/light_tree.h"
+#include "render/lightcuts/vrl_cut.h"
+#include "render/scene/scene.h"
 
+#include <array>
 #include <cstdint>
 #include <functional>
 #include <memory>
 #include <string>
+#include <string_view>
 #include <vector>
 
 namespace vrl {
 
-// Methods the renderer knows; `vrl render --method` takes these names.
+// Methods the renderer knows; `vrl render --method` takes their names (the one
+// name table is methodName / parseRenderMethod; past the command line and the
+// job spec, code compares RenderMethod values, never strings).
 //   path: the volumetric path tracer (reference), one image
 //   vrl:  the four transport parts, multiple scattering by plain VRLs; one layer per part
 //   vrl-lightcuts: the same, multiple scattering by cuts through a VRL light tree,
@@ -27,18 +31,31 @@ namespace vrl {
 //   vpl:  the four parts, multiple scattering by plain VPLs (every VPL at each of
 //         the distance samples; the brute force VPL Lightcuts is measured against)
 //   vpl-lightcuts: the same layers as vrl-lightcuts, multiple scattering by VPL
-//         Lightcuts (the paper's baseline, vpl_lightcuts.h)
+//         Lightcuts (the paper's baseline, lightcuts/vpl_cut.h)
 // For vpl and vpl-lightcuts, vrlCount counts VPLs.
-inline const std::vector<std::string> kRenderMethods = {"path", "vrl", "vrl-lightcuts", "vpl", "vpl-lightcuts"};
+enum class RenderMethod { Path, Vrl, VrlLightcuts, Vpl, VplLightcuts };
+inline constexpr std::array<RenderMethod, 5> kRenderMethods = {RenderMethod::Path, RenderMethod::Vrl,
+                                                               RenderMethod::VrlLightcuts, RenderMethod::Vpl,
+                                                               RenderMethod::VplLightcuts};
+
+// "path", "vrl", "vrl-lightcuts", "vpl", "vpl-lightcuts".
+std::string_view methodName(RenderMethod method);
+// Every method's name, in kRenderMethods order (for the command line's choices).
+std::vector<std::string> renderMethodNames();
+// The method named `name`; throws std::invalid_argument naming it and the valid names.
+RenderMethod parseRenderMethod(std::string_view name);
 
 // The method deposits VPLs (points) rather than VRLs.
-inline bool usesVpls(const std::string& method) { return method == "vpl" || method == "vpl-lightcuts"; }
-
+constexpr bool usesVpls(RenderMethod m) { return m == RenderMethod::Vpl || m == RenderMethod::VplLightcuts; }
 // The method builds a light tree (VRL or VPL Lightcuts): it ships a tree, not a VRL set.
-inline bool usesLightTree(const std::string& method) { return method == "vrl-lightcuts" || method == "vpl-lightcuts"; }
+constexpr bool usesLightTree(RenderMethod m) {
+    return m == RenderMethod::VrlLightcuts || m == RenderMethod::VplLightcuts;
+}
+// The method renders the four transport parts with virtual lights (every method but path).
+constexpr bool usesVirtualLights(RenderMethod m) { return m != RenderMethod::Path; }
 
 struct RenderSettings {
-    std::string method = "path";
+    RenderMethod method = RenderMethod::Path;
     int samplesPerPixel = 1;  // path: per pixel; vrl: for parts (a)-(c)
     uint64_t seed = 0;
     bool jitter = false;  // false: rays through pixel centres (the paper's setting)
@@ -74,8 +91,8 @@ struct RenderStatistics {
 // "rendering"); must be thread-safe.
 using ProgressCallback = std::function<void(const char* phase, double fraction)>;
 
-// Checks the settings; throws std::invalid_argument for an unknown method, a
-// non-positive sample count or a negative error threshold.
+// Checks the settings; throws std::invalid_argument for a non-positive sample
+// count or a negative error threshold.
 void validateRenderSettings(const RenderSettings& settings);
 
 // The per-image light work of a render (the coordinator's part in the service):
@@ -123,7 +140,7 @@ private:
     const Scene& scene_;
     RenderSettings settings_;
     std::vector<std::string> layerNames_;
-    std::unique_ptr<class VrlIntegrator> integrator_;
+    std::unique_ptr<class TransportIntegrator> integrator_;
     std::unique_ptr<class VolumetricPathTracer> tracer_;
 };
 

@@ -1,3 +1,6 @@
+// server/: the coordinator program: a stateless gRPC shell (coordinator_service.h)
+// over the Coordinator and its parts (job store, preparation, leases, workers, tiles).
+//
 // Coordinator: the job side of the service, without gRPC (coordinator_service.h
 // puts it on the network). It keeps scene bundles by SHA-256, prepares each job
 // once (parse, light tracing, light tree, serialisation) on a background thread,
@@ -15,34 +18,38 @@
 // spec, finished jobs (their EXR and record), and the accepted tiles of
 // unfinished jobs (a checkpoint log): such jobs are prepared again (the light
 // tree is deterministic) and resume with only their missing tiles.
+//
+// The work is done by its parts: JobStore (job_store.h: jobs, state directory,
+// checkpoints, blobs), JobPreparation (job_preparation.h), LeaseScheduler
+// (lease_scheduler.h), WorkerRegistry (worker_registry.h) and tile assembly
+// (tile_assembly.h), each on the Job record (job.h). None of them locks: the
+// Coordinator owns them, the one mutex and condition variable and the two
+// threads (preparation, reaper), and calls them with the mutex held.
 #pragma once
 
-#include "proto/service_limits.h"
-#include "render/image.h"
-#include "render/renderer.h"
+#include "server/job.h"
+#include "server/job_preparation.h"
+#include "server/job_store.h"
+#include "server/lease_scheduler.h"
+#include "server/worker_registry.h"
+#include "service/common/limits.h"
+#include "service/common/service_error.h"
 #include "vrl/v1/vrl.pb.h"
 
 #include <chrono>
 #include <condition_variable>
-#include <deque>
+#include <cstdint>
 #include <filesystem>
-#include <fstream>
-#include <map>
 #include <memory>
 #include <mutex>
-#include <stdexcept>
 #include <string>
 #include <thread>
 #include <vector>
 
 namespace vrl::server {
 
-// An error for the caller, with the gRPC-independent kind of status it maps to.
-enum class ErrorKind { InvalidArgument, NotFound, FailedPrecondition, ResourceExhausted };
-struct ServiceError : std::runtime_error {
-    ServiceError(ErrorKind kind, const std::string& message) : std::runtime_error(message), kind(kind) {}
-    ErrorKind kind;
-};
+using rpc::ErrorKind;
+using rpc::ServiceError;
 
 struct CoordinatorOptions {
     std::filesystem::path stateDir = "vrl-state";
@@ -99,43 +106,24 @@ public:
     const rpc::ServiceLimits& limits() const { return options_.limits; }
 
 private:
-    struct Job;
-    struct Lease {
-        std::string jobId;
-        uint32_t tile = 0;
-        std::string workerId;
-        std::chrono::steady_clock::time_point deadline;
-    };
-    struct WorkerRecord {
-        std::string name;
-        uint32_t threads = 0;
-        std::chrono::steady_clock::time_point lastHeartbeat;
-    };
-
-    void loadState();
-    void prepareLoop();
-    void reaperLoop();
-    void prepare(Job& job);  // called without the lock
-    Job& findJob(const std::string& jobId) const;  // lock held; NotFound
-    v1::JobProgress progressOf(const Job& job) const;  // lock held
-    // Checks and applies a tile result; returns the reason it was refused, empty if taken. Lock held.
-    std::string applyTile(Job& job, const v1::TileResult& result, bool replay);
-    void finishJob(Job& job);                     // lock held: all tiles done
+    void prepareLoop();  // the preparation thread
+    void reaperLoop();   // the reaper thread: silent workers, expired leases
+    // Prepares the job without the lock, then puts it to rendering under the lock.
+    void prepare(Job& job);
+    void finishJob(Job& job);  // lock held: all tiles done
     void endJob(Job& job, v1::JobState state, const std::string& message);  // lock held
-    // Lock held. front: an expired lease (soon again); back: a refused tile (others first).
-    void requeue(const std::string& leaseId, bool front = true);
     void countFailure(Job& job, uint32_t tile, const std::string& reason);  // lock held
-    void pruneAssets();                           // lock held
-    void touch(Job& job);                         // lock held: version++ and notify
+    void touch(Job& job);                                                    // lock held: version++ and notify
 
     CoordinatorOptions options_;
+    // The one lock: every part below is called with it held (except JobStore's and
+    // JobPreparation's disk-only work, which their headers name).
     mutable std::mutex mutex_;
-    mutable std::condition_variable changed_;
-    std::map<std::string, std::unique_ptr<Job>> jobs_;
-    std::map<std::string, Lease> leases_;
-    std::map<std::string, WorkerRecord> workers_;
-    std::map<std::string, std::shared_ptr<const std::string>> assets_;
-    uint64_t nextSequence_ = 0, nextLease_ = 0, nextWorker_ = 0;
+    mutable std::condition_variable changed_;  // a job changed, a job was queued, or stopping
+    JobStore store_;
+    WorkerRegistry workers_;
+    LeaseScheduler leases_;
+    JobPreparation preparation_;
     bool draining_ = false, stopping_ = false;
     CoordinatorStatistics statistics_;
     std::thread preparer_, reaper_;

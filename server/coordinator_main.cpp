@@ -1,6 +1,8 @@
 #include "server/coordinator_main.h"
 
 #include "server/coordinator_service.h"
+#include "util/atomic_file.h"
+#include "util/signals.h"
 
 #include <CLI/CLI.hpp>
 #include <spdlog/spdlog.h>
@@ -65,7 +67,7 @@ int coordinatorMain(int argc, char** argv) {
     options.limits.maxBundleBytes = maxBundleMiB << 20;
 
     sigset_t signals;
-    if (!rpc::takeTerminationSignals(signals)) return 1;  // started by `vrl render --workers`, whose process is gone
+    if (!util::takeTerminationSignals(signals)) return 1;  // started by `vrl render --workers`, whose process is gone
 
     std::optional<tbb::global_control> threadLimit;
     if (threads > 0) threadLimit.emplace(tbb::global_control::max_allowed_parallelism, size_t(threads));
@@ -76,8 +78,7 @@ int coordinatorMain(int argc, char** argv) {
         spdlog::info("vrl-coordinator {} serving on {} (port {}), state in '{}'", VRL_VERSION, server.listen,
                      service.port(), options.stateDir.string());
         if (!portFile.empty()) {
-            std::ofstream(portFile + ".tmp") << service.port() << "\n";
-            std::filesystem::rename(portFile + ".tmp", portFile);
+            util::writeFileAtomically(portFile, std::to_string(service.port()) + "\n");
         }
         int signal = 0;
         sigwait(&signals, &signal);

@@ -1,8 +1,8 @@
 #include "server/coordinator_service.h"
 
+#include "util/hash.h"
 #include "vrl/v1/vrl.grpc.pb.h"
 
-#include <grpcpp/health_check_service_interface.h>
 #include <spdlog/spdlog.h>
 
 #include <fstream>
@@ -12,16 +12,6 @@ namespace vrl::server {
 
 namespace {
 
-grpc::Status toStatus(const ServiceError& e) {
-    switch (e.kind) {
-        case ErrorKind::InvalidArgument: return {grpc::StatusCode::INVALID_ARGUMENT, e.what()};
-        case ErrorKind::NotFound: return {grpc::StatusCode::NOT_FOUND, e.what()};
-        case ErrorKind::FailedPrecondition: return {grpc::StatusCode::FAILED_PRECONDITION, e.what()};
-        case ErrorKind::ResourceExhausted: return {grpc::StatusCode::RESOURCE_EXHAUSTED, e.what()};
-    }
-    return {grpc::StatusCode::INTERNAL, e.what()};
-}
-
 // Runs `body` after the token check, mapping exceptions to statuses.
 template <class Body>
 grpc::Status guarded(const grpc::ServerContext* context, const std::string& token, Body&& body) {
@@ -29,7 +19,7 @@ grpc::Status guarded(const grpc::ServerContext* context, const std::string& toke
     try {
         return body();
     } catch (const ServiceError& e) {
-        return toStatus(e);
+        return rpc::toStatus(e);
     } catch (const std::exception& e) {
         spdlog::error("internal error: {}", e.what());
         return {grpc::StatusCode::INTERNAL, e.what()};
@@ -47,7 +37,7 @@ grpc::Status streamBlob(grpc::ServerContext* context, const std::string& blob, c
         v1::DataChunk chunk;
         chunk.set_offset(offset);
         chunk.set_data(blob.data() + offset, size);
-        chunk.set_crc32(rpc::crc32Of(chunk.data()));
+        chunk.set_crc32(util::crc32Of(chunk.data()));
         if (first) {
             chunk.set_total_size(blob.size());
             chunk.set_sha256(sha256);
@@ -95,7 +85,7 @@ public:
                 if (chunk.offset() != blob.size())
                     return {grpc::StatusCode::DATA_LOSS, "bundle chunk at offset " + std::to_string(chunk.offset()) +
                                                              ", expected " + std::to_string(blob.size())};
-                if (rpc::crc32Of(chunk.data()) != chunk.crc32())
+                if (util::crc32Of(chunk.data()) != chunk.crc32())
                     return {grpc::StatusCode::DATA_LOSS, "bundle chunk at offset " + std::to_string(chunk.offset()) +
                                                              " fails its CRC-32; upload again"};
                 if (blob.size() + chunk.data().size() > total)
@@ -144,7 +134,7 @@ public:
                             grpc::ServerWriter<v1::DataChunk>* writer) override {
         return guarded(context, token_, [&] {
             const std::string blob = rpc::readFileText(c_.imageFile(request->job_id()).string());
-            return streamBlob(context, blob, rpc::sha256Hex(blob), 0, writer);
+            return streamBlob(context, blob, util::sha256Hex(blob), 0, writer);
         });
     }
 
@@ -241,14 +231,14 @@ CoordinatorServer::CoordinatorServer(Coordinator& coordinator, const ServerOptio
     : coordinator_(coordinator),
       jobService_(std::make_unique<JobServiceImpl>(coordinator, options.token)),
       workerGateway_(std::make_unique<WorkerGatewayImpl>(coordinator, options.token, !options.tls.clientCaFile.empty())) {
-    grpc::EnableDefaultHealthCheckService(true);
     grpc::ServerBuilder builder;
     rpc::configureServer(builder, options.listen, options.tls, &port_);
     builder.RegisterService(jobService_.get());
     builder.RegisterService(workerGateway_.get());
+    builder.RegisterService(&health_);
     server_ = builder.BuildAndStart();
     if (!server_ || port_ == 0) throw std::runtime_error("cannot listen on '" + options.listen + "' (in use? bad address?)");
-    server_->GetHealthCheckService()->SetServingStatus(true);
+    health_.setServing(true);
     if (options.token.empty())
         spdlog::warn("no token set (--token-file or VRL_TOKEN): anyone who can reach port {} can submit jobs", port_);
 }
@@ -258,7 +248,7 @@ CoordinatorServer::~CoordinatorServer() { shutdown(std::chrono::milliseconds(0))
 void CoordinatorServer::shutdown(std::chrono::milliseconds drainTimeout) {
     if (stopped_) return;
     stopped_ = true;
-    server_->GetHealthCheckService()->SetServingStatus(false);
+    health_.setServing(false);
     coordinator_.beginDrain();
     const auto until = std::chrono::steady_clock::now() + drainTimeout;
     while (coordinator_.activeLeases() > 0 && std::chrono::steady_clock::now() < until)
@@ -266,6 +256,7 @@ void CoordinatorServer::shutdown(std::chrono::milliseconds drainTimeout) {
     if (coordinator_.activeLeases() > 0)
         spdlog::warn("stopping with {} leases outstanding (their tiles are rendered again after a restart)",
                      coordinator_.activeLeases());
+    health_.shutdown();  // ends Watch streams, so Shutdown need not wait for them
     server_->Shutdown(std::chrono::system_clock::now() + std::chrono::seconds(2));
 }
 

@@ -5,8 +5,9 @@
 // awaited (up to a drain timeout), then the server stops.
 #pragma once
 
-#include "proto/rpc_common.h"
 #include "server/coordinator.h"
+#include "service/common/health_service.h"
+#include "service/common/rpc_common.h"
 
 #include <grpcpp/grpcpp.h>
 
@@ -37,6 +38,7 @@ private:
     Coordinator& coordinator_;
     std::unique_ptr<JobServiceImpl> jobService_;
     std::unique_ptr<WorkerGatewayImpl> workerGateway_;
+    rpc::HealthService health_;  // grpc.health.v1: SERVING until shutdown begins
     std::unique_ptr<grpc::Server> server_;
     int port_ = 0;
     bool stopped_ = false;

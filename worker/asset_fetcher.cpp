@@ -1,6 +1,7 @@
 #include "worker/asset_fetcher.h"
 
-#include "proto/rpc_common.h"
+#include "service/common/rpc_common.h"
+#include "util/hash.h"
 #include "vrl/v1/vrl.grpc.pb.h"
 
 #include <spdlog/spdlog.h>
@@ -33,7 +34,7 @@ std::string AssetFetcher::fetch(const std::string& sha256, uint64_t expectedSize
         v1::DataChunk chunk;
         bool broken = false;
         while (reader->Read(&chunk)) {
-            if (chunk.offset() != blob.size() || rpc::crc32Of(chunk.data()) != chunk.crc32() ||
+            if (chunk.offset() != blob.size() || util::crc32Of(chunk.data()) != chunk.crc32() ||
                 blob.size() + chunk.data().size() > expectedSize) {
                 problem = "chunk at offset " + std::to_string(chunk.offset()) + " failed its check";
                 spdlog::warn("asset {}: {}; fetching again from offset {}", sha256.substr(0, 12), problem, blob.size());
@@ -60,7 +61,7 @@ std::string AssetFetcher::fetch(const std::string& sha256, uint64_t expectedSize
             spdlog::warn("asset {}: {}; resuming", sha256.substr(0, 12), problem);
             continue;
         }
-        if (rpc::sha256Hex(blob) != sha256) {
+        if (util::sha256Hex(blob) != sha256) {
             problem = "the whole blob fails its SHA-256";
             spdlog::warn("asset {}: {}; fetching it again", sha256.substr(0, 12), problem);
             blob.clear();

@@ -1,11 +1,12 @@
 #include "worker/worker.h"
 
-#include "proto/job_scene.h"
-#include "proto/scene_bundle.h"
-#include "render/light_tree_io.h"
+#include "render/lightcuts/light_tree_io.h"
+#include "service/job/job_scene.h"
+#include "service/job/scene_bundle.h"
+#include "util/atomic_file.h"
+#include "util/random_id.h"
 #include "vrl/v1/vrl.grpc.pb.h"
 
-#include <grpcpp/health_check_service_interface.h>
 #include <spdlog/spdlog.h>
 #include <tbb/info.h>
 #include <unistd.h>
@@ -48,28 +49,30 @@ Worker::Worker(WorkerOptions options) : options_(std::move(options)) {
     channel_ = rpc::makeChannel(options_.coordinator, options_.tls);
     fetcher_ = std::make_unique<AssetFetcher>(channel_, options_.token);
     if (options_.cacheDir.empty()) {
-        std::random_device device;
-        cacheDir_ = fs::temp_directory_path() / ("vrl-worker-" + std::to_string(getpid()) + "-" + std::to_string(device()));
+        cacheDir_ = fs::temp_directory_path() / ("vrl-worker-" + std::to_string(getpid()) + "-" + util::randomHex(8));
         ownsCacheDir_ = true;
     } else {
         cacheDir_ = options_.cacheDir;
     }
     fs::create_directories(cacheDir_);
     if (!options_.healthListen.empty()) {
-        grpc::EnableDefaultHealthCheckService(true);
         grpc::ServerBuilder builder;
+        builder.RegisterService(&health_);
         int port = 0;
         builder.AddListeningPort(options_.healthListen, grpc::InsecureServerCredentials(), &port);
         healthServer_ = builder.BuildAndStart();
         if (!healthServer_ || port == 0)
             throw std::runtime_error("cannot serve health checks on '" + options_.healthListen + "'");
-        healthServer_->GetHealthCheckService()->SetServingStatus(false);
+        health_.setServing(false);  // SERVING once registered
     }
 }
 
 Worker::~Worker() {
     stop();
-    if (healthServer_) healthServer_->Shutdown(std::chrono::system_clock::now() + 1s);
+    if (healthServer_) {
+        health_.shutdown();
+        healthServer_->Shutdown(std::chrono::system_clock::now() + 1s);
+    }
     if (ownsCacheDir_) {
         std::error_code error;
         fs::remove_all(cacheDir_, error);
@@ -77,6 +80,7 @@ Worker::~Worker() {
 }
 
 void Worker::stop() {
+    health_.setServing(false);  // draining: take no new work
     {
         std::lock_guard lock(mutex_);  // so a sleeper cannot miss the wake-up
         stopping_ = true;
@@ -124,7 +128,7 @@ void Worker::registerWorker() {
             heartbeatIntervalMs_ = std::max<uint32_t>(10, reply.heartbeat_interval_ms());
             reregister_ = false;
             spdlog::info("registered with {} as {} ({} threads)", options_.coordinator, workerId_, options_.threads);
-            if (healthServer_) healthServer_->GetHealthCheckService()->SetServingStatus(true);
+            health_.setServing(true);
             return;
         }
         if (!retryable(status))
@@ -159,7 +163,7 @@ void Worker::run() {
     for (auto& loop : loops) loop.join();
     stop();
     heartbeat.join();
-    if (healthServer_) healthServer_->GetHealthCheckService()->SetServingStatus(false);
+    health_.setServing(false);
     spdlog::info("worker {} stopped ({} tiles returned)", workerId_, statistics().tilesAccepted);
     if (failure) std::rethrow_exception(failure);
 }
@@ -180,6 +184,7 @@ void Worker::heartbeatLoop() {
         if (status.ok() && !reply.known()) {
             spdlog::warn("the coordinator forgot this worker (it restarted, or heartbeats were late); registering again");
             reregister_ = true;
+            health_.setServing(false);  // until registered again
         } else if (!status.ok()) {
             spdlog::warn("heartbeat failed: {}", rpc::describe(status));
         }
@@ -228,9 +233,7 @@ std::shared_ptr<const Worker::JobContext> Worker::loadJob(const std::string& job
             std::error_code error;
             fs::remove_all(bundleDir, error);  // a half-written copy from a crash
             sceneFile = rpc::extractBundle(bundle, bundleDir);
-            const fs::path partial = marker.string() + ".partial";
-            std::ofstream(partial) << bundle.scene_path();
-            fs::rename(partial, marker);
+            util::writeFileAtomically(marker, bundle.scene_path());
         }
         context->scene = rpc::loadJobScene(bundleDir, sceneFile, assets.spec(), options_.limits);
         if (context->scene.width != int(assets.width()) || context->scene.height != int(assets.height()) ||
@@ -240,7 +243,7 @@ std::shared_ptr<const Worker::JobContext> Worker::loadJob(const std::string& job
         if (!assets.lights_sha256().empty()) {
             const std::string blob = fetcher_->fetch(assets.lights_sha256(), assets.lights_size());
             const auto* data = reinterpret_cast<const uint8_t*>(blob.data());
-            if (usesLightTree(assets.spec().parameters().method()))
+            if (usesLightTree(context->scene.settings.method))
                 context->lights.tree = deserializeLightTree(data, blob.size());
             else
                 context->lights.vrls = deserializeVrlSet(data, blob.size());
@@ -282,6 +285,7 @@ void Worker::leaseLoop() {
         if (!status.ok()) {
             if (status.error_code() == grpc::StatusCode::FAILED_PRECONDITION) {
                 reregister_ = true;  // the coordinator forgot us
+                health_.setServing(false);
                 continue;
             }
             if (status.error_code() == grpc::StatusCode::UNAUTHENTICATED)

@@ -1,3 +1,5 @@
+// worker/: the worker program: leases tiles from a coordinator and shades them.
+//
 // Worker: registers with a coordinator, leases tiles, downloads and verifies
 // each job's assets once (cached by hash; several jobs at once, no process-wide
 // state), builds the job's Embree scene and shades tiles with the same
@@ -5,8 +7,9 @@
 // loop per thread keeps every thread busy while others talk to the coordinator.
 #pragma once
 
-#include "proto/rpc_common.h"
-#include "proto/service_limits.h"
+#include "service/common/health_service.h"
+#include "service/common/limits.h"
+#include "service/common/rpc_common.h"
 #include "worker/asset_fetcher.h"
 
 #include <atomic>
@@ -76,6 +79,7 @@ private:
     WorkerOptions options_;
     std::shared_ptr<grpc::Channel> channel_;
     std::unique_ptr<AssetFetcher> fetcher_;
+    rpc::HealthService health_;  // SERVING while registered, NOT_SERVING while starting or draining
     std::unique_ptr<grpc::Server> healthServer_;
     std::filesystem::path cacheDir_;
     bool ownsCacheDir_ = false;

@@ -1,5 +1,6 @@
 #include "worker/worker_main.h"
 
+#include "util/signals.h"
 #include "worker/worker.h"
 
 #include <CLI/CLI.hpp>
@@ -45,7 +46,7 @@ int workerMain(int argc, char** argv) {
     }
     spdlog::set_level(spdlog::level::from_str(logLevel));
     sigset_t signals;
-    if (!rpc::takeTerminationSignals(signals)) return 1;  // started by `vrl render --workers`, whose process is gone
+    if (!util::takeTerminationSignals(signals)) return 1;  // started by `vrl render --workers`, whose process is gone
     try {
         options.token = rpc::loadToken(tokenFile);
         Worker worker(options);

@@ -21,24 +21,24 @@ std::string compactCount(uint64_t n) {
 std::vector<MethodRun> sweep(bool quick) {
     std::vector<MethodRun> runs;
     if (quick) {
-        for (int spp : {4, 16, 64}) runs.push_back({"path", 0, spp});
-        runs.push_back({"vrl", 1000, 16});
-        runs.push_back({"vrl", 3000, 64});
-        runs.push_back({"vrl-lightcuts", 3000, 16, 0.02f});
-        runs.push_back({"vrl-lightcuts", 10000, 64, 0.02f});
-        runs.push_back({"vrl-lightcuts", 10000, 64, 0.1f});
-        runs.push_back({"vpl-lightcuts", 3000, 16, 0.02f});
-        runs.push_back({"vpl-lightcuts", 10000, 64, 0.02f});
+        for (int spp : {4, 16, 64}) runs.push_back({RenderMethod::Path, 0, spp});
+        runs.push_back({RenderMethod::Vrl, 1000, 16});
+        runs.push_back({RenderMethod::Vrl, 3000, 64});
+        runs.push_back({RenderMethod::VrlLightcuts, 3000, 16, 0.02f});
+        runs.push_back({RenderMethod::VrlLightcuts, 10000, 64, 0.02f});
+        runs.push_back({RenderMethod::VrlLightcuts, 10000, 64, 0.1f});
+        runs.push_back({RenderMethod::VplLightcuts, 3000, 16, 0.02f});
+        runs.push_back({RenderMethod::VplLightcuts, 10000, 64, 0.02f});
         return runs;
     }
-    for (int spp : {16, 64, 256, 1024}) runs.push_back({"path", 0, spp});
+    for (int spp : {16, 64, 256, 1024}) runs.push_back({RenderMethod::Path, 0, spp});
     const std::pair<uint64_t, int> plain[] = {{1000, 64}, {4000, 256}, {16000, 1024}};
-    for (const auto& [n, spp] : plain) runs.push_back({"vrl", n, spp});
+    for (const auto& [n, spp] : plain) runs.push_back({RenderMethod::Vrl, n, spp});
     const std::pair<uint64_t, int> many[] = {{10000, 64}, {100000, 256}, {1000000, 1024}};
-    for (const auto& [n, spp] : many) runs.push_back({"vrl-lightcuts", n, spp, 0.02f});
+    for (const auto& [n, spp] : many) runs.push_back({RenderMethod::VrlLightcuts, n, spp, 0.02f});
     for (const auto& [n, spp] : many)
-        if (n < 1000000) runs.push_back({"vrl-lightcuts", n, spp, 0.1f});
-    for (const auto& [n, spp] : many) runs.push_back({"vpl-lightcuts", n, spp, 0.02f});
+        if (n < 1000000) runs.push_back({RenderMethod::VrlLightcuts, n, spp, 0.1f});
+    for (const auto& [n, spp] : many) runs.push_back({RenderMethod::VplLightcuts, n, spp, 0.02f});
     return runs;
 }
 
@@ -46,9 +46,9 @@ std::vector<MethodRun> sweep(bool quick) {
 
 std::string MethodRun::label() const {
     char buffer[96];
-    if (method == "path") {
+    if (method == RenderMethod::Path) {
         std::snprintf(buffer, sizeof buffer, "%d spp", spp);
-    } else if (method == "vrl" || method == "vpl") {
+    } else if (!usesLightTree(method)) {
         std::snprintf(buffer, sizeof buffer, "N=%s %d spp", compactCount(lights).c_str(), spp);
     } else {
         std::snprintf(buffer, sizeof buffer, "N=%s e=%g %d spp", compactCount(lights).c_str(), double(errorThreshold), spp);

@@ -3,6 +3,8 @@
 // relative to the shared scene folder; our own are in the repository.
 #pragma once
 
+#include "render/renderer.h"
+
 #include <cstdint>
 #include <filesystem>
 #include <map>
@@ -14,7 +16,7 @@ namespace vrl::report {
 // One render of the sweep. `lights`: VRLs or VPLs (0 for the path tracer);
 // `spp`: samples per pixel (path tracer; parts (a)-(c) of the virtual-light methods).
 struct MethodRun {
-    std::string method;
+    RenderMethod method = RenderMethod::Path;
     uint64_t lights = 0;
     int spp = 1;
     float errorThreshold = 0.02f;

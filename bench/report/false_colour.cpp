@@ -1,6 +1,6 @@
 #include "bench/report/false_colour.h"
 
-#include "render/preview_image.h"
+#include "render/image/preview_image.h"
 
 #include <algorithm>
 #include <array>

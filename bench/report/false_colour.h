@@ -4,7 +4,7 @@
 // (dark blue -> green -> yellow, viridis-like).
 #pragma once
 
-#include "render/image.h"
+#include "render/image/image.h"
 
 #include <filesystem>
 

@@ -10,17 +10,18 @@
 #include "bench/report/benchmark_scenes.h"
 #include "bench/report/curve_ratios.h"
 #include "bench/report/false_colour.h"
-#include "proto/rpc_common.h"
 
-#include "render/exr_io.h"
-#include "render/image_metrics.h"
-#include "render/light_tracer.h"
-#include "render/medium_fill.h"
-#include "render/mitsuba_parser.h"
-#include "render/preview_image.h"
+#include "render/core/timing.h"
+#include "render/image/exr_io.h"
+#include "render/image/image_metrics.h"
+#include "render/image/preview_image.h"
+#include "render/render_metadata.h"
 #include "render/renderer.h"
-#include "render/scene.h"
-#include "render/timing.h"
+#include "render/scene/scene.h"
+#include "render/scene_io/medium_fill.h"
+#include "render/scene_io/mitsuba/mitsuba_parser.h"
+#include "render/vrl/light_tracer.h"
+#include "util/hash.h"
 
 #include <CLI/CLI.hpp>
 #include <spdlog/spdlog.h>
@@ -107,9 +108,9 @@ std::string hashSceneAndSettings(const BenchmarkScene& s, const std::string& set
         std::ifstream in(f, std::ios::binary);
         std::ostringstream bytes;
         bytes << in.rdbuf();
-        all += "\n" + f.filename().string() + ":" + rpc::sha256Hex(bytes.str());
+        all += "\n" + f.filename().string() + ":" + util::sha256Hex(bytes.str());
     }
-    return rpc::sha256Hex(all).substr(0, 16);
+    return util::sha256Hex(all).substr(0, 16);
 }
 
 std::unique_ptr<Scene> loadScene(const BenchmarkScene& s) {
@@ -147,7 +148,7 @@ Image referenceImage(const BenchmarkScene& s, const Scene& scene, const fs::path
     if (fs::exists(file)) {
         set = readExr(file);
         info.cached = true;
-        info.seconds = std::atof(set.metadata["vrl.report.seconds"].c_str());
+        info.seconds = metadataNumber(set.metadata["vrl.report.seconds"]);
         log.line("%s: reference from the cache (%s)", s.name.c_str(), file.filename().c_str());
     } else {
         log.line("%s: rendering the reference, path tracer %d spp in two halves (%dx%d)...", s.name.c_str(), 2 * half,
@@ -155,7 +156,7 @@ Image referenceImage(const BenchmarkScene& s, const Scene& scene, const fs::path
         const auto start = Clock::now();
         std::vector<Image> halves;
         for (uint64_t h = 0; h < 2; ++h) {
-            MethodRun run{"path", 0, half};
+            MethodRun run{RenderMethod::Path, 0, half};
             int lastDecile = -1;
             halves.push_back(render(scene, settingsFor(s, run, 1000003 + h), [&](const char*, double f) {
                 const int decile = int(f * 10.0);
@@ -170,8 +171,17 @@ Image referenceImage(const BenchmarkScene& s, const Scene& scene, const fs::path
         for (size_t i = 0; i < mean.pixelCount(); ++i) mean[i] = (halves[0][i] + halves[1][i]) * 0.5f;
         set.image = mean;
         set.layers = {{"half1", halves[0]}, {"half2", halves[1]}};
+        RenderRecord record;
+        record.scene = s.file.string();
+        record.defines = s.defines;
+        record.medium = s.medium;
+        record.settings = settingsFor(s, MethodRun{RenderMethod::Path, 0, half}, 1000003);
+        record.settings.samplesPerPixel = 2 * half;  // the two halves together
+        record.statistics.seconds = info.seconds;
+        record.run = {{"halves", int32_t(2)}};
+        writeRenderMetadata(record, scene.camera(), set.metadata);
         set.metadata["vrl.report.key"] = key;
-        set.metadata["vrl.report.seconds"] = std::to_string(info.seconds);
+        set.metadata["vrl.report.seconds"] = info.seconds;
         fs::create_directories(cacheDir);
         writeExr(file, set);
         log.line("%s: reference done in %.1f s -> %s", s.name.c_str(), info.seconds, file.string().c_str());
@@ -198,10 +208,10 @@ std::vector<SpeedupResult> measureSpeedup(const BenchmarkScene& s, const Scene& 
     std::vector<SpeedupResult> results;
     for (const bool points : {false, true}) {
         for (const uint64_t n : s.speedupLights) {
-            RenderSettings plain = settingsFor(s, MethodRun{points ? "vpl" : "vrl", n, 1}, 7);
+            RenderSettings plain = settingsFor(s, MethodRun{points ? RenderMethod::Vpl : RenderMethod::Vrl, n, 1}, 7);
             plain.transports = TransportSelection::parse("multiple");
             RenderSettings cuts = plain;
-            cuts.method = points ? "vpl-lightcuts" : "vrl-lightcuts";
+            cuts.method = points ? RenderMethod::VplLightcuts : RenderMethod::VrlLightcuts;
             RenderLights plainLights = prepareLights(scene, plain);
             RenderLights cutLights;
             cutLights.tree = LightTree::build(plainLights.vrls.vrls, LightTreeSettings{cuts.partitionSize, cuts.seed, points});
@@ -266,18 +276,20 @@ std::string safeName(std::string s) {
     return s;
 }
 
-const char* methodTitle(const std::string& m) {
-    if (m == "path") return "path tracing";
-    if (m == "vrl") return "plain VRLs";
-    if (m == "vrl-lightcuts") return "VRL Lightcuts";
-    if (m == "vpl-lightcuts") return "VPL Lightcuts";
-    if (m == "vpl") return "plain VPLs";
-    return m.c_str();
+const char* methodTitle(RenderMethod m) {
+    switch (m) {
+        case RenderMethod::Path: return "path tracing";
+        case RenderMethod::Vrl: return "plain VRLs";
+        case RenderMethod::VrlLightcuts: return "VRL Lightcuts";
+        case RenderMethod::VplLightcuts: return "VPL Lightcuts";
+        case RenderMethod::Vpl: return "plain VPLs";
+    }
+    return "?";
 }
 
 // A method's curve at the default threshold (or all its runs for path / vrl).
 std::vector<CurvePoint> curveOf(const std::vector<RunResult>& results, const std::string& scene,
-                                const std::string& method, bool smape) {
+                                RenderMethod method, bool smape) {
     std::vector<CurvePoint> points;
     for (const auto& r : results) {
         if (r.scene != scene || r.run.method != method) continue;
@@ -292,7 +304,7 @@ struct SceneReport {
     ReferenceInfo reference;
     double loadSeconds = 0.0;
     std::string skipped;  // reason, if skipped
-    std::map<std::string, std::pair<double, double>> tableStats;  // method -> (#Eval, #Inter)
+    std::map<RenderMethod, std::pair<double, double>> tableStats;  // method -> (#Eval, #Inter)
     std::vector<std::string> images;  // markdown image lines
 };
 
@@ -329,7 +341,7 @@ void writeSummary(const fs::path& path, const Options& o, const std::vector<Scen
            << fmt(s.reference.noiseSmape) << " |\n";
     }
     md << "\n";
-    const std::vector<std::string> others = {"vrl", "vpl-lightcuts", "path"};
+    const std::vector<RenderMethod> others = {RenderMethod::Vrl, RenderMethod::VplLightcuts, RenderMethod::Path};
     for (const auto& s : scenes) {
         if (!s.skipped.empty()) continue;
         const std::string& name = s.scene.name;
@@ -354,7 +366,7 @@ void writeSummary(const fs::path& path, const Options& o, const std::vector<Scen
         for (size_t k = 0; k < others.size(); ++k) md << "---|---|---|";
         md << "\n";
         for (const auto& r : results) {
-            if (r.scene != name || r.run.method != "vrl-lightcuts" || r.run.errorThreshold != 0.02f) continue;
+            if (r.scene != name || r.run.method != RenderMethod::VrlLightcuts || r.run.errorThreshold != 0.02f) continue;
             md << "| " << r.run.label() << " | " << fmt(r.seconds) << " |";
             for (const auto& m : others) {
                 const auto rmseCurve = curveOf(results, name, m, false), smapeCurve = curveOf(results, name, m, true);
@@ -373,11 +385,11 @@ void writeSummary(const fs::path& path, const Options& o, const std::vector<Scen
     md << "| scene | N | VPL Lightcuts #Eval | #Inter | VRL Lightcuts #Eval | #Inter |\n|---|---|---|---|---|---|\n";
     for (const auto& s : scenes) {
         if (!s.skipped.empty()) continue;
-        const auto get = [&](const char* m) {
+        const auto get = [&](RenderMethod m) {
             const auto it = s.tableStats.find(m);
             return it == s.tableStats.end() ? std::pair<double, double>(NAN, NAN) : it->second;
         };
-        const auto vpl = get("vpl-lightcuts"), vrlc = get("vrl-lightcuts");
+        const auto vpl = get(RenderMethod::VplLightcuts), vrlc = get(RenderMethod::VrlLightcuts);
         md << "| " << s.scene.name << " | " << s.scene.tableLights << " | " << fmt(vpl.first, 4) << " | "
            << fmt(vpl.second, 4) << " | " << fmt(vrlc.first, 4) << " | " << fmt(vrlc.second, 4) << " |\n";
     }
@@ -442,27 +454,29 @@ int runReport(const Options& o) {
                 ImageSet images = render(*scene, settings, {}, &stats);
                 RunResult r{s.name, run, secondsSince(runStart), compareImages(reference, images.image), stats};
                 log.line("%s (%zu/%zu): %-13s %-22s %8.2f s  RMSE %.4g  rel %.4g  SMAPE %.4g%s", s.name.c_str(), done,
-                         totalRuns, run.method.c_str(), run.label().c_str(), r.seconds, r.metrics.rmse,
+                         totalRuns, std::string(methodName(run.method)).c_str(), run.label().c_str(), r.seconds, r.metrics.rmse,
                          r.metrics.relativeRmse, r.metrics.smape,
                          r.metrics.nonFinitePixels ? "  (NON-FINITE PIXELS)" : "");
                 if (usesLightTree(run.method) && run.lights == s.tableLights && run.errorThreshold == 0.02f) {
                     report.tableStats[run.method] = {stats.meanEvaluated, stats.meanIntersected};
                     for (const char* counter : {"eval", "inter"}) {
                         if (const Image* layer = layerOf(images, counter))
-                            lastOfMethod[run.method + "/" + counter] = ImageSet{*layer, {}, {}};
+                            lastOfMethod[std::string(methodName(run.method)) + "/" + counter] = ImageSet{*layer, {}, {}};
                     }
                 }
-                if (run.method != "vrl-lightcuts" || run.errorThreshold == 0.02f) {
-                    lastOfMethod[run.method] = ImageSet{images.image, {}, {}};
-                    lastLabel[run.method] = run.label();
+                if (run.method != RenderMethod::VrlLightcuts || run.errorThreshold == 0.02f) {
+                    lastOfMethod[std::string(methodName(run.method))] = ImageSet{images.image, {}, {}};
+                    lastLabel[std::string(methodName(run.method))] = run.label();
                 }
                 results.push_back(std::move(r));
             }
-            for (const auto& m : {"path", "vrl", "vrl-lightcuts", "vpl-lightcuts"}) {
+            for (const RenderMethod method : {RenderMethod::Path, RenderMethod::Vrl, RenderMethod::VrlLightcuts,
+                                              RenderMethod::VplLightcuts}) {
+                const std::string m(methodName(method));
                 if (!lastOfMethod.count(m)) continue;
                 const std::string file = safeName(s.name) + "-" + m + ".png";
                 writePreviewPng(lastOfMethod[m].image, o.out / "images" / file, exposure);
-                row += " " + std::string(methodTitle(m)) + ", " + lastLabel[m] + " |";
+                row += " " + std::string(methodTitle(method)) + ", " + lastLabel[m] + " |";
                 header += "---|";
                 imageRow += " ![](images/" + file + ") |";
             }
@@ -472,18 +486,19 @@ int runReport(const Options& o) {
             // Figure 6: #Eval and #Inter in false colour, one scale per counter for both methods.
             for (const char* counter : {"eval", "inter"}) {
                 float clip = 0.0f;
-                for (const char* m : {"vpl-lightcuts", "vrl-lightcuts"}) {
-                    const auto it = lastOfMethod.find(std::string(m) + "/" + counter);
+                for (const RenderMethod method : {RenderMethod::VplLightcuts, RenderMethod::VrlLightcuts}) {
+                    const auto it = lastOfMethod.find(std::string(methodName(method)) + "/" + counter);
                     if (it != lastOfMethod.end()) clip = std::max(clip, percentileValue(it->second.image, 0.98f));
                 }
                 std::string line = "| #" + std::string(counter == std::string("eval") ? "Eval" : "Inter") +
                                    " (scale 0 to " + fmt(clip, 4) + ", 98th percentile) |";
-                for (const char* m : {"vpl-lightcuts", "vrl-lightcuts"}) {
-                    const auto it = lastOfMethod.find(std::string(m) + "/" + counter);
+                for (const RenderMethod method : {RenderMethod::VplLightcuts, RenderMethod::VrlLightcuts}) {
+                    const std::string m(methodName(method));
+                    const auto it = lastOfMethod.find(m + "/" + counter);
                     if (it == lastOfMethod.end()) continue;
                     const std::string file = safeName(s.name) + "-" + m + "-" + counter + ".png";
                     writeFalseColourPng(it->second.image, clip, o.out / "images" / file);
-                    line += " ![" + std::string(methodTitle(m)) + "](images/" + file + ") |";
+                    line += " ![" + std::string(methodTitle(method)) + "](images/" + file + ") |";
                 }
                 if (counter == std::string("eval")) {
                     report.images.push_back("Figure 6 (N = " + std::to_string(s.tableLights) +
@@ -502,7 +517,7 @@ int runReport(const Options& o) {
         csv << "scene,method,setting,vrls,spp,error_threshold,seconds,rmse,rel_rmse,smape,mean_eval,mean_inter,mean_cut,mean_ratio\n";
         csv << std::setprecision(6);
         for (const auto& r : results)
-            csv << r.scene << "," << r.run.method << "," << r.run.label() << "," << r.run.lights << "," << r.run.spp << ","
+            csv << r.scene << "," << methodName(r.run.method) << "," << r.run.label() << "," << r.run.lights << "," << r.run.spp << ","
                 << r.run.errorThreshold << "," << r.seconds << "," << r.metrics.rmse << "," << r.metrics.relativeRmse << ","
                 << r.metrics.smape << "," << r.stats.meanEvaluated << "," << r.stats.meanIntersected << ","
                 << r.stats.meanCutSize << ","

@@ -1,0 +1,73 @@
+#include "render/core/distance.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace vrl {
+
+namespace {
+using V3d = Imath::V3d;
+V3d toDouble(const Vec3& v) { return {v.x, v.y, v.z}; }
+}  // namespace
+
+double maxSubtendedAngle(double segmentLength, double h) {
+    if (!(h > 0.0)) return M_PI;
+    return 2.0 * std::atan(segmentLength / (2.0 * h));
+}
+
+double distanceLineSegment(const Vec3& origin, const Vec3& direction, const Vec3& a, const Vec3& b) {
+    const V3d d = toDouble(direction);
+    const V3d ra = toDouble(a) - toDouble(origin), ab = toDouble(b) - toDouble(a);
+    const V3d p = ra - d * d.dot(ra), q = ab - d * d.dot(ab);  // components across the line
+    const double qq = q.length2();
+    const double s = qq > 0.0 ? std::clamp(-p.dot(q) / qq, 0.0, 1.0) : 0.0;
+    return (p + q * s).length();
+}
+
+double distanceLineBox(const Vec3& origin, const Vec3& direction, const Imath::Box3f& box) {
+    if (box.isEmpty()) return std::numeric_limits<double>::infinity();
+    // Does the infinite line pass through the box? (slab test over all t)
+    double tNear = -std::numeric_limits<double>::infinity(), tFar = std::numeric_limits<double>::infinity();
+    bool crosses = true;
+    for (int axis = 0; axis < 3 && crosses; ++axis) {
+        const double o = origin[axis], d = direction[axis], lo = box.min[axis], hi = box.max[axis];
+        if (d == 0.0) {
+            crosses = o >= lo && o <= hi;
+        } else {
+            double t0 = (lo - o) / d, t1 = (hi - o) / d;
+            if (t0 > t1) std::swap(t0, t1);
+            tNear = std::max(tNear, t0);
+            tFar = std::min(tFar, t1);
+            crosses = tNear <= tFar;
+        }
+    }
+    if (crosses) return 0.0;
+    // Otherwise the distance, a convex function over the box, is smallest on an edge.
+    double best = std::numeric_limits<double>::infinity();
+    const Vec3 lo = box.min, hi = box.max;
+    for (int axis = 0; axis < 3; ++axis) {
+        const int u = (axis + 1) % 3, v = (axis + 2) % 3;
+        for (int corner = 0; corner < 4; ++corner) {
+            Vec3 a, b;
+            a[u] = b[u] = (corner & 1) ? hi[u] : lo[u];
+            a[v] = b[v] = (corner & 2) ? hi[v] : lo[v];
+            a[axis] = lo[axis];
+            b[axis] = hi[axis];
+            best = std::min(best, distanceLineSegment(origin, direction, a, b));
+        }
+    }
+    return best;
+}
+
+double distancePointBox(const Vec3& point, const Imath::Box3f& box) {
+    double d2 = 0.0;
+    for (int a = 0; a < 3; ++a) {
+        const double p = point[a];
+        const double gap = std::max({double(box.min[a]) - p, 0.0, p - double(box.max[a])});
+        d2 += gap * gap;
+    }
+    return std::sqrt(d2);
+}
+
+}  // namespace vrl

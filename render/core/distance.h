@@ -1,0 +1,22 @@
+// Distances between points, lines, segments and boxes, in double precision:
+// the geometric terms of the cluster bounds (lightcuts/) and of the VRL and
+// VPL estimators. `direction` arguments are unit vectors; a line is infinite
+// in both directions. An empty box is infinitely far from everything.
+#pragma once
+
+#include "render/core/geometry.h"
+
+#include <Imath/ImathBox.h>
+
+namespace vrl {
+
+// The largest angle a segment of length `segmentLength` subtends from a point at
+// distance h from its line (foot point in the middle): 2 atan(S / (2 h)); pi at h = 0.
+double maxSubtendedAngle(double segmentLength, double h);
+// Distance between the infinite line (origin, unit direction) and a box / a segment [a, b].
+double distanceLineBox(const Vec3& origin, const Vec3& direction, const Imath::Box3f& box);
+double distanceLineSegment(const Vec3& origin, const Vec3& direction, const Vec3& a, const Vec3& b);
+// Distance from a point to a box (0 inside it).
+double distancePointBox(const Vec3& point, const Imath::Box3f& box);
+
+}  // namespace vrl

@@ -1,0 +1,124 @@
+#include "render/integrators/path_tracer.h"
+
+#include "render/core/sampling.h"
+#include "render/vrl/camera_segment.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace vrl {
+
+DirectLighting sampleDirectLighting(const Scene& scene, const Vec3& point, const SurfaceHit* surface, int medium,
+                                    Rng& rng) {
+    const EmitterSampler& sampler = scene.emitterSampler();
+    if (sampler.empty()) return {};
+    const auto [index, probability] = sampler.sample(rng.next());
+    const Vec2 u(rng.next(), rng.next());
+    const DirectLightSample light = scene.emitters()[index]->sampleDirect(point, u);
+    if (isBlack(light.weight)) return {};
+    Vec3 origin = point;
+    if (surface) {
+        origin = Scene::offsetOrigin(*surface, light.direction);
+        medium = scene.mediumAfter(*surface, light.direction, medium);
+    }
+    const Rgb tr = scene.transmittance(origin, light.position, medium);
+    if (isBlack(tr)) return {light.direction, Rgb(0.0f)};
+    return {light.direction, light.weight * tr / probability};
+}
+
+Rgb VolumetricPathTracer::radiance(Ray ray, int medium, Rng& rng, const PathStart& start) const {
+    Rgb result(0.0f), throughput(1.0f);
+    int vertices = start.vertices;  // scattering vertices so far (null crossings do not count)
+    // Until the first vertex that is not a crossing (or, with start.throughSpecular, not a
+    // purely specular bounce): the stretch crossed with exact transmittance only.
+    bool firstSegment = true;
+    const int maxDepth = settings_.maxDepth;
+    const auto mayScatterAgain = [&] { return maxDepth < 0 || vertices < maxDepth; };
+    // Restriction to medium-medium prefixes: contributions count from the second vertex on.
+    const bool restricted = settings_.onlyMediumToMedium;
+    const auto counts = [&] { return !restricted || vertices >= 2; };
+    // An emitter hit at the end of the current segment is counted: NEE could not have found it
+    // (the camera ray itself, or the bounce before was a Dirac lobe).
+    bool emissionCounts = start.emissionOnFirstHit && !restricted;
+
+    float segmentStart = ray.tMin;  // where the ray entered its current medium
+    int mediumBeforeCrossing = medium;  // before the last null boundary crossed
+    for (int steps = 0; steps < 100000; ++steps) {
+        const auto hit = scene_.intersect(ray);
+        const float tSurface = hit ? hit->t : ray.tMax;
+
+        if (medium >= 0 && firstSegment && start.firstSegmentTransmittanceOnly) {
+            throughput *= scene_.media()[medium].transmittance(tSurface - segmentStart);
+        } else if (medium >= 0) {
+            const HomogeneousMedium& m = scene_.media()[medium];
+            const FreeFlightSample flight = m.sampleFreeFlight(tSurface - segmentStart, rng.next(), rng.next());
+            throughput *= flight.weight;
+            if (flight.scattered) {
+                ++vertices;
+                firstSegment = false;
+                emissionCounts = false;
+                if (!mayScatterAgain()) break;
+                const Vec3 x = ray.at(segmentStart + flight.t);
+                const DirectLighting direct = sampleDirectLighting(scene_, x, nullptr, medium, rng);
+                if (counts() && !isBlack(direct.radianceOverPdf))
+                    result += throughput * direct.radianceOverPdf * m.phase().eval(ray.direction, direct.direction);
+                // Exact phase sampling: the weight f/pdf is 1.
+                const PhaseSample next = m.phase().sample(ray.direction, Vec2(rng.next(), rng.next()));
+                ray = Ray{x, next.direction};
+                segmentStart = 0.0f;
+                if (vertices >= settings_.rouletteDepth) {
+                    const float q = std::min(maxComponent(throughput), 0.95f);
+                    if (rng.next() >= q) break;
+                    throughput /= q;
+                }
+                continue;
+            }
+        }
+        if (!hit || isBlack(throughput)) break;
+
+        const SceneShape& shape = scene_.shapes()[hit->shape];
+        if (emissionCounts && shape.emitter >= 0)
+            result += throughput * scene_.emitters()[shape.emitter]->emittedRadiance(hit->geometricNormal, -ray.direction);
+
+        const Bsdf& bsdf = shape.bsdf;
+        if (bsdf.isNull()) {
+            if (!Scene::withinCrossing(ray, *hit)) mediumBeforeCrossing = medium;
+            medium = scene_.mediumAfter(*hit, ray.direction, medium);
+            segmentStart = hit->t;
+            Scene::continuePast(ray, *hit);  // same ray: distances stay exact
+            continue;
+        }
+        const bool specularChain =
+            firstSegment && start.throughSpecular && bsdf.isPurelySpecular() && vertices < kMaxSpecularChain;
+        if (!specularChain) firstSegment = false;
+        if (Scene::withinCrossing(ray, *hit)) medium = mediumBeforeCrossing;
+        if (restricted && vertices + 1 <= 2) break;  // a surface among the first two vertices
+
+        ++vertices;
+        if (!mayScatterAgain()) break;
+        const ShadingPoint sp = hit->shadingPoint();
+        const Vec3 wo = -ray.direction;
+        if (!bsdf.isPurelySpecular()) {
+            const DirectLighting direct = sampleDirectLighting(scene_, hit->position, &*hit, medium, rng);
+            if (counts() && !isBlack(direct.radianceOverPdf)) {
+                const Rgb f = bsdf.eval(sp, wo, direct.direction, TransportMode::Radiance);
+                if (!isBlack(f)) result += throughput * direct.radianceOverPdf * f;
+            }
+        }
+        const auto sampled = bsdf.sample(sp, wo, Vec2(rng.next(), rng.next()), rng.next(), TransportMode::Radiance);
+        if (!sampled || isBlack(sampled->weight)) break;
+        throughput *= sampled->weight;
+        emissionCounts = sampled->delta && (!restricted || vertices >= 2);
+        medium = scene_.mediumAfter(*hit, sampled->wi, medium);
+        ray = Ray{Scene::offsetOrigin(*hit, sampled->wi), sampled->wi};
+        segmentStart = 0.0f;
+        if (vertices >= settings_.rouletteDepth) {
+            const float q = std::min(maxComponent(throughput), 0.95f);
+            if (rng.next() >= q) break;
+            throughput /= q;
+        }
+    }
+    return result;
+}
+
+}  // namespace vrl

@@ -1,0 +1,123 @@
+#include "render/integrators/transport_integrator.h"
+
+#include <spdlog/spdlog.h>
+
+#include <cmath>
+
+namespace vrl {
+
+TransportIntegrator::TransportIntegrator(const Scene& scene, const VrlSet& vrls, const TransportIntegratorSettings& settings,
+                             const LightTree* tree)
+    : scene_(scene),
+      vrls_(vrls),
+      settings_(settings),
+      tracer_(scene, PathTracerSettings{settings.maxDepth}),
+      estimator_(scene, settings.vrlSamples),
+      tree_(tree) {
+    if (settings.vpls && tree_)
+        vplLightcuts_ = std::make_unique<VplLightcutsEstimator>(scene, *tree_, settings.cut, settings.vplDistanceSamples);
+    else if (settings.vpls)
+        plainVpls_ = std::make_unique<VplEstimator>(scene, vrls.vrls, settings.vplDistanceSamples);
+    else if (tree_)
+        lightcuts_ = std::make_unique<LightcutsEstimator>(scene, *tree_, estimator_, settings.cut);
+    if (settings.maxDepth >= 0 && settings.maxDepth < 16 && scene.hasSpecularSurfaces() &&
+        settings.transports.has(TransportPart::Multiple))
+        spdlog::warn("maxDepth {} with specular surfaces: multiple scattering (d) seen through glass or mirrors "
+                     "does not count the specular bounces towards maxDepth", settings.maxDepth);
+}
+
+std::array<Rgb, 4> TransportIntegrator::samplePathParts(const Ray& cameraRay, Rng& rng) const {
+    std::array<Rgb, 4> parts{Rgb(0.0f), Rgb(0.0f), Rgb(0.0f), Rgb(0.0f)};
+    if (settings_.transports.has(TransportPart::Surface))
+        parts[size_t(TransportPart::Surface)] =
+            tracer_.radiance(cameraRay, scene_.cameraMedium(), rng, PathStart{0, true, true, true});
+    const bool single = settings_.transports.has(TransportPart::Single);
+    const bool mediumSurface = settings_.transports.has(TransportPart::MediumSurface);
+    if (!single && !mediumSurface) return parts;
+    for (const CameraSegment& segment : cameraSegments(scene_, cameraRay, scene_.cameraMedium(), &rng, settings_.maxDepth)) {
+        if (scene_.media()[segment.medium].isNonScattering()) continue;
+        if (single) parts[size_t(TransportPart::Single)] += singleScattering(segment, rng);
+        if (mediumSurface) parts[size_t(TransportPart::MediumSurface)] += mediumToSurface(segment, rng);
+    }
+    return parts;
+}
+
+Rgb TransportIntegrator::singleScattering(const CameraSegment& segment, Rng& rng) const {
+    if (settings_.maxDepth >= 0 && settings_.maxDepth < segment.specularBefore + 2) return Rgb(0.0f);
+    const EmitterSampler& sampler = scene_.emitterSampler();
+    if (sampler.empty()) return Rgb(0.0f);
+    const auto [index, probability] = sampler.sample(rng.next());
+    const Emitter& emitter = *scene_.emitters()[index];
+    // Equiangular towards a point of the light (its position, or a random point of an area light).
+    const Vec3 towards = emitter.sampleDirect(segment.origin, Vec2(rng.next(), rng.next())).position;
+    const DistanceSample us = sampleEquiangular(segment.origin, segment.direction, segment.length, towards, rng.next());
+    if (!(us.pdf > 0.0f)) return Rgb(0.0f);
+    const Vec3 x = segment.origin + segment.direction * us.t;
+    const DirectLightSample light = emitter.sampleDirect(x, Vec2(rng.next(), rng.next()));
+    if (isBlack(light.weight)) return Rgb(0.0f);
+    const Rgb toLight = scene_.transmittance(x, light.position, segment.medium);
+    if (isBlack(toLight)) return Rgb(0.0f);
+    const HomogeneousMedium& medium = scene_.media()[segment.medium];
+    const float phase = medium.phase().eval(-light.direction, -segment.direction);
+    return segment.throughputBefore * medium.transmittance(us.t) * medium.sigmaS() * light.weight * toLight *
+           (phase / (probability * us.pdf));
+}
+
+Rgb TransportIntegrator::mediumToSurface(const CameraSegment& segment, Rng& rng) const {
+    if (settings_.maxDepth >= 0 && settings_.maxDepth < segment.specularBefore + 3) return Rgb(0.0f);
+    const HomogeneousMedium& medium = scene_.media()[segment.medium];
+    // u on [0, length] from one channel's truncated exponential, chosen uniformly;
+    // the pdf is the average over channels (spectral MIS), so no channel's
+    // transmittance outruns its density in chromatic media.
+    const double length = segment.length;
+    const auto truncatedPdf = [&](double sigma, double u) {
+        if (sigma * length < 1e-6) return 1.0 / length;
+        return sigma * std::exp(-sigma * u) / -std::expm1(-sigma * length);
+    };
+    const int channel = std::min(2, int(rng.next() * 3.0f));
+    const double sigmaChannel = medium.sigmaT()[channel], xi = rng.next();
+    const double u = sigmaChannel * length < 1e-6
+                         ? xi * length
+                         : std::min(length, -std::log1p(xi * std::expm1(-sigmaChannel * length)) / sigmaChannel);
+    double pdf = 0.0;
+    for (int c = 0; c < 3; ++c) pdf += truncatedPdf(medium.sigmaT()[c], u) / 3.0;
+    if (!(pdf > 0.0) || !std::isfinite(pdf)) return Rgb(0.0f);
+    const Vec3 x = segment.origin + segment.direction * float(u);
+    const PhaseSample next = medium.phase().sample(segment.direction, Vec2(rng.next(), rng.next()));
+    // Exact transmittance to the next surface, reflected light only: a path that
+    // scatters again in the medium first belongs to (d), emission at the surface to (b).
+    const Rgb reflected = tracer_.radiance(Ray{x, next.direction}, segment.medium, rng, PathStart{1 + segment.specularBefore, true, false});
+    return segment.throughputBefore * medium.transmittance(float(u)) * medium.sigmaS() * reflected *
+           float(1.0 / pdf);
+}
+
+Rgb TransportIntegrator::multipleScattering(const Ray& cameraRay, Rng& rng, CutStatistics* statistics) const {
+    Rgb sum(0.0f);
+    if (!settings_.transports.has(TransportPart::Multiple)) return sum;
+    CutStatistics unused;
+    // One stream family per camera segment; VRL k draws from (key, k) in both plain
+    // and Lightcuts shading, so the two differ only by the cut's approximation.
+    const uint64_t pixelKey = (uint64_t(rng.nextUint()) << 32) | rng.nextUint();
+    uint64_t segmentIndex = 0;
+    for (const CameraSegment& segment : cameraSegments(scene_, cameraRay, scene_.cameraMedium(), &rng, settings_.maxDepth)) {
+        const uint64_t streamKey = Rng::combine(pixelKey, segmentIndex++);
+        if (scene_.media()[segment.medium].isNonScattering()) continue;
+        if (vplLightcuts_ || plainVpls_) {
+            // The same distance samples in both: they differ only by the cut.
+            Rng segmentRng = vrlStream(streamKey, ~0u);
+            sum += vplLightcuts_ ? vplLightcuts_->estimate(segment, segmentRng, statistics ? *statistics : unused)
+                                 : plainVpls_->estimate(segment, segmentRng);
+        } else if (lightcuts_) {
+            sum += lightcuts_->estimate(segment, streamKey, statistics ? *statistics : unused);
+        } else {
+            const auto& vrls = tree_ ? tree_->vrls() : vrls_.vrls;
+            for (uint32_t k = 0; k < vrls.size(); ++k) {
+                Rng vrlRng = vrlStream(streamKey, k);
+                sum += estimator_.contribution(vrls[k], segment, vrlRng);
+            }
+        }
+    }
+    return sum;
+}
+
+}  // namespace vrl

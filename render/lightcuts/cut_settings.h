@@ -1,0 +1,36 @@
+// Settings and per-pixel statistics shared by every Lightcuts walk (VRL and VPL
+// cuts, cut_walk.h): the relative error threshold, the cut-size safety valve,
+// the parameters of the cluster bounds, and the counters of the paper's Table 1.
+#pragma once
+
+#include <cstdint>
+
+namespace vrl {
+
+struct ClusterBoundSettings {
+    uint32_t exactDistanceBelow = 32;  // VRL nodes with at most this many VRLs: h_min from their segments
+    float anisotropyEpsilon = 1.0f;    // HG media: bound x (1 + epsilon)
+};
+
+struct CutSettings {
+    float errorThreshold = 0.02f;
+    uint32_t maxCutSize = 4096;
+    ClusterBoundSettings bound;
+};
+
+// Per-pixel counters (the paper's Table 1).
+struct CutStatistics {
+    uint32_t evaluated = 0;    // #Eval: estimator evaluations (nodes and leaves)
+    uint32_t intersected = 0;  // #Inter: nodes whose box the camera line crossed
+    uint32_t cutSize = 0;      // nodes in the final cut
+    uint32_t boundExceeded = 0;  // inner-node estimates above their bound (HG media; 0 if isotropic)
+    uint32_t boundedEstimates = 0;  // inner-node estimates checked against their bound
+
+    CutStatistics& operator+=(const CutStatistics& o) {
+        evaluated += o.evaluated, intersected += o.intersected, cutSize += o.cutSize;
+        boundExceeded += o.boundExceeded, boundedEstimates += o.boundedEstimates;
+        return *this;
+    }
+};
+
+}  // namespace vrl

@@ -1,0 +1,218 @@
+#include "render/lightcuts/light_tree_io.h"
+
+#include "util/hash.h"
+
+#include <algorithm>
+#include <bit>
+#include <cstring>
+#include <iterator>
+#include <stdexcept>
+#include <string>
+
+namespace vrl {
+namespace {
+
+constexpr char kMagic[8] = {'V', 'R', 'L', 'T', 'R', 'E', 'E', '\0'};
+constexpr char kSetMagic[8] = {'V', 'R', 'L', 'S', 'E', 'T', '\0', '\0'};
+constexpr size_t kSetHeaderBytes = 8 + 4 * 4;  // magic, version, count, light paths (2 x u32)
+constexpr size_t kHeaderBytes = 8 + 4 * 4;  // magic, version, vrl count, node count, root
+constexpr size_t kVrlBytes = 11 * 4;
+constexpr size_t kNodeBytes = 18 * 4;
+constexpr size_t kCrcBytes = 4;
+
+class Writer {
+public:
+    explicit Writer(size_t capacity) { bytes_.reserve(capacity); }
+    void u32(uint32_t v) {
+        for (int shift = 0; shift < 32; shift += 8) bytes_.push_back(static_cast<uint8_t>(v >> shift));
+    }
+    void i32(int32_t v) { u32(static_cast<uint32_t>(v)); }
+    void f32(float v) { u32(std::bit_cast<uint32_t>(v)); }
+    void v3(const Imath::V3f& v) {
+        f32(v.x);
+        f32(v.y);
+        f32(v.z);
+    }
+    std::vector<uint8_t>& bytes() { return bytes_; }
+
+private:
+    std::vector<uint8_t> bytes_;
+};
+
+// Reads fields from a range whose size the caller has already checked; every
+// read is still bounds-checked so a logic error cannot read past the end.
+class Reader {
+public:
+    Reader(const uint8_t* data, size_t size) : data_(data), size_(size) {}
+    uint32_t u32() {
+        if (size_ - pos_ < 4) throw std::runtime_error("light tree blob: internal error, read past the end");
+        uint32_t v = 0;
+        for (int i = 0; i < 4; ++i) v |= uint32_t(data_[pos_ + i]) << (8 * i);
+        pos_ += 4;
+        return v;
+    }
+    int32_t i32() { return static_cast<int32_t>(u32()); }
+    float f32() { return std::bit_cast<float>(u32()); }
+    Imath::V3f v3() {
+        Imath::V3f v;
+        v.x = f32();
+        v.y = f32();
+        v.z = f32();
+        return v;
+    }
+
+private:
+    const uint8_t* data_;
+    size_t size_;
+    size_t pos_ = 0;
+};
+
+void writeVrl(Writer& out, const Vrl& v) {
+    out.v3(v.origin);
+    out.v3(v.direction);
+    out.f32(v.length);
+    out.v3(v.flux);
+    out.i32(v.medium);
+}
+
+Vrl readVrl(Reader& in) {
+    Vrl v;
+    v.origin = in.v3();
+    v.direction = in.v3();
+    v.length = in.f32();
+    v.flux = in.v3();
+    v.medium = in.i32();
+    return v;
+}
+
+uint64_t blobBytes(uint64_t vrlCount, uint64_t nodeCount) {
+    return kHeaderBytes + vrlCount * kVrlBytes + nodeCount * kNodeBytes + kCrcBytes;
+}
+
+}  // namespace
+
+std::vector<uint8_t> serializeLightTree(const LightTree& tree) {
+    const auto& vrls = tree.vrls();
+    const auto& nodes = tree.nodes();
+    if (vrls.size() > UINT32_MAX || nodes.size() > UINT32_MAX)
+        throw std::invalid_argument("light tree too large to serialise (more than 2^32 - 1 VRLs or nodes)");
+    Writer out(blobBytes(vrls.size(), nodes.size()));
+    out.bytes().insert(out.bytes().end(), std::begin(kMagic), std::end(kMagic));
+    out.u32(kLightTreeFormatVersion);
+    out.u32(static_cast<uint32_t>(vrls.size()));
+    out.u32(static_cast<uint32_t>(nodes.size()));
+    out.i32(tree.root());
+    for (const Vrl& v : vrls) writeVrl(out, v);
+    for (const LightTreeNode& n : nodes) {
+        out.v3(n.box.min);
+        out.v3(n.box.max);
+        out.v3(n.fluxLength);
+        out.v3(n.clusterFlux);
+        out.f32(n.maxLength);
+        out.u32(n.representative);
+        out.u32(n.vrlCount);
+        out.i32(n.left);
+        out.i32(n.right);
+        out.i32(n.medium);
+    }
+    out.u32(util::crc32Of(out.bytes().data(), out.bytes().size()));
+    return std::move(out.bytes());
+}
+
+LightTree deserializeLightTree(const uint8_t* data, size_t size) {
+    if (size > 0 && data == nullptr) throw std::invalid_argument("deserializeLightTree: null data");
+    // Magic first, over however many bytes there are, so a foreign file is named as such.
+    const size_t magicBytes = std::min(size, sizeof kMagic);
+    if (magicBytes > 0 && std::memcmp(data, kMagic, magicBytes) != 0)
+        throw std::runtime_error("not a VRL light tree (the blob does not start with \"VRLTREE\")");
+    if (size < kHeaderBytes + kCrcBytes)
+        throw std::runtime_error("light tree blob is truncated: expected at least " +
+                                 std::to_string(kHeaderBytes + kCrcBytes) + " bytes, found " + std::to_string(size));
+    Reader header(data + sizeof kMagic, kHeaderBytes - sizeof kMagic);
+    const uint32_t version = header.u32();
+    if (version != kLightTreeFormatVersion)
+        throw std::runtime_error("light tree blob has format version " + std::to_string(version) +
+                                 " but this build reads version " + std::to_string(kLightTreeFormatVersion) +
+                                 "; rebuild the tree with this version");
+    const uint32_t vrlCount = header.u32();
+    const uint32_t nodeCount = header.u32();
+    const int32_t root = header.i32();
+    const uint64_t expected = blobBytes(vrlCount, nodeCount);  // no overflow: < 2^39
+    if (size != expected) {
+        const std::string counts = "expected " + std::to_string(expected) + " bytes for the " +
+                                   std::to_string(vrlCount) + " VRLs and " + std::to_string(nodeCount) +
+                                   " nodes its header declares, found " + std::to_string(size) + " bytes";
+        throw std::runtime_error(size < expected ? "light tree blob is truncated (or its header corrupt): " + counts
+                                                 : "light tree blob is longer than expected (trailing data or a "
+                                                   "corrupt header): " + counts);
+    }
+    const uint32_t storedCrc = Reader(data + size - kCrcBytes, kCrcBytes).u32();
+    const uint32_t actualCrc = util::crc32Of(data, size - kCrcBytes);
+    if (storedCrc != actualCrc)
+        throw std::runtime_error("light tree blob is corrupt: checksum mismatch (stored CRC-32 " +
+                                 std::to_string(storedCrc) + ", computed " + std::to_string(actualCrc) + ")");
+
+    Reader in(data + kHeaderBytes, size - kHeaderBytes - kCrcBytes);
+    std::vector<Vrl> vrls(vrlCount);  // sizes verified against the blob above
+    for (Vrl& v : vrls) v = readVrl(in);
+    std::vector<LightTreeNode> nodes(nodeCount);
+    for (LightTreeNode& n : nodes) {
+        n.box.min = in.v3();
+        n.box.max = in.v3();
+        n.fluxLength = in.v3();
+        n.clusterFlux = in.v3();
+        n.maxLength = in.f32();
+        n.representative = in.u32();
+        n.vrlCount = in.u32();
+        n.left = in.i32();
+        n.right = in.i32();
+        n.medium = in.i32();
+    }
+    try {
+        return LightTree::fromParts(std::move(vrls), std::move(nodes), root);
+    } catch (const std::invalid_argument& e) {
+        throw std::runtime_error(std::string("light tree blob holds a structurally invalid tree (checksum is valid, "
+                                             "so it was written that way): ") + e.what());
+    }
+}
+
+std::vector<uint8_t> serializeVrlSet(const VrlSet& set) {
+    if (set.vrls.size() > UINT32_MAX) throw std::invalid_argument("VRL set too large to serialise (over 2^32 - 1)");
+    Writer out(kSetHeaderBytes + set.vrls.size() * kVrlBytes + kCrcBytes);
+    out.bytes().insert(out.bytes().end(), std::begin(kSetMagic), std::end(kSetMagic));
+    out.u32(kLightTreeFormatVersion);
+    out.u32(static_cast<uint32_t>(set.vrls.size()));
+    out.u32(static_cast<uint32_t>(set.lightPaths));
+    out.u32(static_cast<uint32_t>(set.lightPaths >> 32));
+    for (const Vrl& v : set.vrls) writeVrl(out, v);
+    out.u32(util::crc32Of(out.bytes().data(), out.bytes().size()));
+    return std::move(out.bytes());
+}
+
+VrlSet deserializeVrlSet(const uint8_t* data, size_t size) {
+    if (size > 0 && data == nullptr) throw std::invalid_argument("deserializeVrlSet: null data");
+    if (size < kSetHeaderBytes + kCrcBytes || std::memcmp(data, kSetMagic, sizeof kSetMagic) != 0)
+        throw std::runtime_error("not a VRL set blob (too short, or it does not start with \"VRLSET\")");
+    Reader header(data + sizeof kSetMagic, kSetHeaderBytes - sizeof kSetMagic);
+    const uint32_t version = header.u32();
+    if (version != kLightTreeFormatVersion)
+        throw std::runtime_error("VRL set blob has format version " + std::to_string(version) +
+                                 " but this build reads version " + std::to_string(kLightTreeFormatVersion));
+    const uint32_t count = header.u32();
+    const uint64_t low = header.u32(), high = header.u32();
+    const uint64_t expected = kSetHeaderBytes + uint64_t(count) * kVrlBytes + kCrcBytes;
+    if (size != expected)
+        throw std::runtime_error("VRL set blob has the wrong size: expected " + std::to_string(expected) +
+                                 " bytes for " + std::to_string(count) + " VRLs, found " + std::to_string(size));
+    const uint32_t storedCrc = Reader(data + size - kCrcBytes, kCrcBytes).u32();
+    if (storedCrc != util::crc32Of(data, size - kCrcBytes))
+        throw std::runtime_error("VRL set blob is corrupt: checksum mismatch");
+    Reader in(data + kSetHeaderBytes, size - kSetHeaderBytes - kCrcBytes);
+    VrlSet set;
+    set.lightPaths = low | (high << 32);
+    set.vrls.resize(count);
+    for (Vrl& v : set.vrls) v = readVrl(in);
+    return set;
+}
+
+}  // namespace vrl

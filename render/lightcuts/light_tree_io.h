@@ -1,0 +1,54 @@
+// Binary serialisation of a LightTree (its VRLs and nodes), so a tree built once
+// can be cached on disk or shipped to another worker and used bit-for-bit.
+//
+// Layout, every field little-endian, written field by field (no struct memory,
+// so neither padding nor ABI leaks in); floats as their IEEE-754 bit patterns,
+// so -0 and NaN payloads survive:
+//   magic    8 bytes  "VRLTREE\0"
+//   version  u32      kLightTreeFormatVersion
+//   vrls     u32      number of VRLs V
+//   nodes    u32      number of nodes N
+//   root     i32      root node index, -1 for an empty tree
+//   V x VRL  44 bytes origin xyz, direction xyz, length, flux rgb (f32), medium (i32)
+//   N x node 72 bytes box min xyz, box max xyz, fluxLength rgb, clusterFlux rgb,
+//                     maxLength (f32), representative, vrlCount (u32),
+//                     left, right, medium (i32)
+//   crc      u32      CRC-32 (zlib) of every byte before it
+#pragma once
+
+#include "render/lightcuts/light_tree.h"
+
+#include <cstddef>
+#include <cstdint>
+#include <vector>
+
+namespace vrl {
+
+inline constexpr uint32_t kLightTreeFormatVersion = 1;
+
+// Serialises `tree` into a self-contained blob (layout above). Throws
+// std::invalid_argument if it has more than 2^32 - 1 VRLs or nodes.
+std::vector<uint8_t> serializeLightTree(const LightTree& tree);
+
+// Parses a blob written by serializeLightTree; the bit-exact inverse.
+// Throws std::runtime_error, with a message a user can act on, for: a wrong
+// magic ("not a VRL light tree"), another format version (both named), a blob
+// shorter or longer than its header's counts require (bytes expected and
+// found), a checksum mismatch, and a structurally invalid tree (the reason
+// LightTree::fromParts gives). Checks are made in that order. Never reads out
+// of bounds; counts are checked against the blob size before anything is
+// allocated from them.
+LightTree deserializeLightTree(const uint8_t* data, size_t size);
+inline LightTree deserializeLightTree(const std::vector<uint8_t>& blob) {
+    return deserializeLightTree(blob.data(), blob.size());
+}
+
+// The plain `vrl` method ships its VRLs without a tree, in the same style:
+//   magic "VRLSET\0\0", version u32 (kLightTreeFormatVersion), count u32,
+//   light paths u32 low + u32 high, count x VRL (44 bytes as above), crc u32.
+std::vector<uint8_t> serializeVrlSet(const VrlSet& set);
+// The inverse; throws std::runtime_error (wrong magic or version, wrong size,
+// checksum mismatch) like deserializeLightTree.
+VrlSet deserializeVrlSet(const uint8_t* data, size_t size);
+
+}  // namespace vrl

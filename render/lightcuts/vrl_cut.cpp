@@ -1,0 +1,39 @@
+#include "render/lightcuts/vrl_cut.h"
+
+#include "render/lightcuts/cut_walk.h"
+#include "render/scene/scene.h"
+
+namespace vrl {
+
+LightcutsEstimator::LightcutsEstimator(const Scene& scene, const LightTree& tree, const VrlEstimator& estimator,
+                                       CutSettings settings)
+    : tree_(tree), estimator_(estimator), settings_(settings), bound_(scene, tree, settings.bound) {}
+
+Rgb LightcutsEstimator::estimate(const CameraSegment& segment, uint64_t streamKey, CutStatistics& statistics) const {
+    if (tree_.empty() || !(segment.length > 0.0f)) return Rgb(0.0f);
+    struct Visitor {
+        const LightcutsEstimator& self;
+        const CameraSegment& segment;
+        uint64_t streamKey;
+        Rgb leaf(int32_t i) const {
+            const uint32_t k = self.tree_.nodes()[i].representative;
+            Rng rng = vrlStream(streamKey, k);
+            return self.estimator_.contribution(self.tree_.vrls()[k], segment, rng);
+        }
+        bool bound(int32_t i, Rgb& b) const {
+            bool crosses = false;
+            b = self.bound_.bound(i, segment, &crosses);
+            return !crosses;
+        }
+        Rgb estimate(int32_t i) const {
+            const LightTreeNode& node = self.tree_.nodes()[i];
+            Vrl representative = self.tree_.vrls()[node.representative];
+            representative.flux = node.clusterFlux;
+            Rng rng = vrlStream(streamKey, node.representative);
+            return self.estimator_.contribution(representative, segment, rng);
+        }
+    };
+    return walkCut(tree_, settings_, statistics, Visitor{*this, segment, streamKey});
+}
+
+}  // namespace vrl

@@ -1,0 +1,100 @@
+// render/materials/: how surfaces scatter light: BSDFs, microfacet distributions,
+// Fresnel terms and bitmap textures.
+//
+// Bsdf: the surface models of the scene subset (BsdfDescription lists them with
+// their Mitsuba parameters). Directions are world-space unit vectors pointing
+// away from the surface: wo towards the previous path vertex (the viewer on a
+// camera path, the light on a light path), wi towards the next one.
+//
+// Sidedness follows Mitsuba: the front is the side the geometric normal points
+// to. One-sided models (all but dielectric/roughdielectric and twosided ones) are
+// black when wo is behind. Reflection needs wo and wi on the same geometric side,
+// transmission on opposite sides (no light leaks through shading normals).
+//
+// eval returns f(wo, wi) |cos(wi, n_s)| for the non-Dirac lobes only (zero for
+// a purely specular model); sample may pick a Dirac lobe (BsdfSample::delta) and
+// then returns its weight directly. In Importance mode (light paths) the
+// adjoint corrections apply: no 1/eta^2 radiance scaling on refraction, and the
+// shading-normal factor |wo.n_s||wi.n_g| / (|wo.n_g||wi.n_s|) (Veach 1997 §5.3).
+#pragma once
+
+#include "render/core/geometry.h"
+#include "render/core/rgb.h"
+#include "render/materials/texture.h"
+#include "render/scene/scene_description.h"
+
+#include <optional>
+#include <span>
+
+namespace vrl {
+
+enum class TransportMode { Radiance, Importance };
+
+// The surface point as a BSDF sees it.
+struct ShadingPoint {
+    Vec3 geometricNormal;  // unit, the shape's front side
+    Vec3 shadingNormal;    // unit, in the same hemisphere as geometricNormal
+    Vec2 uv{0.0f, 0.0f};
+};
+
+struct BsdfSample {
+    Vec3 wi;
+    Rgb weight{0.0f};    // f |cos(wi, n_s)| / pdf (with the Importance-mode corrections)
+    float pdf = 0.0f;    // solid-angle pdf; for a Dirac lobe, the probability of picking it
+    bool delta = false;  // a Dirac (specular) lobe was sampled
+};
+
+class Bsdf {
+public:
+    // The default is Mitsuba's default material: diffuse, reflectance 0.5, one-sided.
+    Bsdf() = default;
+    // textures[i] is the loaded SceneDescription::textures[i] (a ColorDescription's index).
+    Bsdf(const BsdfDescription& description, std::span<const std::shared_ptr<const Texture>> textures);
+    static Bsdf null();
+
+    BsdfDescription::Kind kind() const { return kind_; }
+    bool isNull() const { return kind_ == BsdfDescription::Kind::Null; }
+    // Every lobe is a Dirac (dielectric, conductor): eval is always zero.
+    bool isPurelySpecular() const;
+    // Some lobe is a Dirac (dielectric, conductor, plastic): paths must count
+    // emission found after sampling it.
+    bool hasSpecular() const;
+    bool twoSided() const { return twoSided_; }
+
+    Rgb eval(const ShadingPoint& sp, const Vec3& wo, const Vec3& wi, TransportMode mode) const;
+    float pdf(const ShadingPoint& sp, const Vec3& wo, const Vec3& wi) const;
+    // u: two uniforms for the direction, uLobe: one for the choice of lobe.
+    std::optional<BsdfSample> sample(const ShadingPoint& sp, const Vec3& wo, const Vec2& u, float uLobe,
+                                     TransportMode mode) const;
+    // Hemispherical reflectance estimate (for previews and light-tree weights): the
+    // diffuse colour, or the specular colour for metals and glass.
+    Rgb albedo(const Vec2& uv) const;
+
+private:
+    // Local-frame models (bsdf.cpp): wo, wi in the shading frame, already checked
+    // against the geometric sides (both z > 0 for the reflection models).
+    Rgb evalLocal(const Vec3& wo, const Vec3& wi, const Vec2& uv, TransportMode mode) const;
+    float pdfLocal(const Vec3& wo, const Vec3& wi) const;
+    // Plastic models: diffuse base colour with the internal-reflection term, and the
+    // probability of sampling the specular lobe for wo.z = cosThetaO.
+    Rgb plasticDiffuse(const Vec2& uv) const;
+    float plasticSpecularProbability(float cosThetaO) const;
+    bool transmits() const;
+
+    BsdfDescription::Kind kind_ = BsdfDescription::Kind::Diffuse;
+    TexturedColor reflectance_{Rgb(0.5f), nullptr};
+    TexturedColor specularReflectance_{Rgb(1.0f), nullptr};
+    TexturedColor specularTransmittance_{Rgb(1.0f), nullptr};
+    float eta_ = 1.5046f / 1.000277f;  // interior / exterior index (dielectric, plastic)
+    Rgb conductorEta_{1.0f}, conductorK_{0.0f};  // relative to the exterior
+    MicrofacetKind distribution_ = MicrofacetKind::Beckmann;
+    float alphaU_ = 0.1f, alphaV_ = 0.1f;
+    bool nonlinear_ = false;
+    BsdfDescription::WardVariant wardVariant_ = BsdfDescription::WardVariant::Balanced;
+    bool twoSided_ = false;
+    // Plastic: diffuse Fresnel reflectance inside (Fdr) and the specular sampling weight.
+    float fdrInternal_ = 0.0f, fdrExternal_ = 0.0f;
+    float specularSamplingWeight_ = 0.5f;
+};
+
+}  // namespace vrl

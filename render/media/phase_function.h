@@ -1,0 +1,41 @@
+// PhaseFunction: isotropic or Henyey-Greenstein scattering distribution, a
+// value type (no tables: both are sampled exactly). Directions are
+// *propagation* directions: `dirIn` is where light travelled before the
+// scattering event, `dirOut` after it, so g > 0 means forward scattering.
+// eval() returns the density in 1/sr; it integrates to 1 over the sphere.
+#pragma once
+
+#include "render/core/geometry.h"
+
+namespace vrl {
+
+struct PhaseSample {
+    Vec3 direction;  // dirOut, unit
+    float pdf;       // equals eval(): sampling is exact
+};
+
+class PhaseFunction {
+public:
+    static constexpr float kIsotropicBelow = 1e-6f;  // |g| below this is isotropic
+
+    static PhaseFunction isotropic() { return PhaseFunction(0.0f); }
+    // g in (-1, 1); throws std::invalid_argument otherwise. |g| < kIsotropicBelow is isotropic.
+    static PhaseFunction henyeyGreenstein(float g);
+
+    float g() const { return g_; }
+    bool isIsotropic() const { return g_ == 0.0f; }
+
+    // Density for the cosine between propagation directions.
+    float evalCosine(float cosTheta) const;
+    float eval(const Vec3& dirIn, const Vec3& dirOut) const { return evalCosine(dirIn.dot(dirOut)); }
+    // Samples dirOut given dirIn from two uniform numbers in [0,1).
+    PhaseSample sample(const Vec3& dirIn, const Vec2& u) const;
+    // Samples the cosine alone (the azimuth is uniform).
+    float sampleCosine(float u) const;
+
+private:
+    explicit PhaseFunction(float g) : g_(g) {}
+    float g_;
+};
+
+}  // namespace vrl

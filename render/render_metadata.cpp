@@ -1,0 +1,55 @@
+#include "render/render_metadata.h"
+
+#include "render/scene/camera.h"
+
+#include <cstdint>
+
+namespace vrl {
+
+void writeRenderMetadata(const RenderRecord& record, const PerspectiveCamera& camera, Metadata& metadata) {
+    const RenderSettings& s = record.settings;
+    const RenderStatistics& stats = record.statistics;
+    metadata["vrl.version"] = std::string(VRL_VERSION);
+    metadata["vrl.scene"] = record.scene;
+    metadata["vrl.method"] = std::string(methodName(s.method));
+    metadata["vrl.spp"] = int32_t(s.samplesPerPixel);
+    metadata["vrl.seed"] = std::to_string(s.seed);
+    metadata["vrl.maxDepth"] = int32_t(s.maxDepth);
+    metadata["vrl.jitter"] = int32_t(s.jitter ? 1 : 0);
+    metadata["vrl.width"] = int32_t(camera.width());
+    metadata["vrl.height"] = int32_t(camera.height());
+    std::string defines;
+    for (const auto& [name, value] : record.defines) defines += (defines.empty() ? "" : " ") + name + "=" + value;
+    metadata["vrl.defines"] = defines;
+    if (!record.medium.empty()) metadata["vrl.medium"] = record.medium;
+    for (const auto& [key, value] : record.sceneNotes) metadata[key] = value;
+
+    if (usesVirtualLights(s.method)) {
+        metadata["vrl.transport"] = s.transports.toString();
+        metadata["vrl.vrlSamples"] = int32_t(s.vrlSamples);
+        metadata[usesVpls(s.method) ? "vrl.vpls" : "vrl.vrls"] = double(stats.vrlCount);
+        metadata["vrl.lightPaths"] = double(stats.lightPaths);
+        metadata["vrl.time.lightTracing"] = stats.tracingSeconds;
+    }
+    if (usesVpls(s.method)) metadata["vrl.vplDistanceSamples"] = int32_t(s.vplDistanceSamples);
+    if (usesLightTree(s.method)) {
+        metadata["vrl.error"] = s.cut.errorThreshold;
+        metadata["vrl.maxCut"] = int32_t(s.cut.maxCutSize);
+        metadata["vrl.exactDistanceBelow"] = int32_t(s.cut.bound.exactDistanceBelow);
+        metadata["vrl.hgEpsilon"] = s.cut.bound.anisotropyEpsilon;
+        metadata["vrl.partitionSize"] = int32_t(s.partitionSize);
+        metadata["vrl.meanEval"] = stats.meanEvaluated;
+        metadata["vrl.meanInter"] = stats.meanIntersected;
+        metadata["vrl.meanCut"] = stats.meanCutSize;
+        metadata["vrl.boundExceeded"] = double(stats.boundExceeded);
+        metadata["vrl.boundedEstimates"] = double(stats.boundedEstimates);
+        metadata["vrl.time.treeBuild"] = stats.treeSeconds;
+    }
+    metadata["vrl.time.render"] = stats.seconds;
+    for (const auto& [phase, seconds] : record.phases) metadata["vrl.time." + phase] = seconds;
+    for (const auto& [key, value] : record.run) metadata["vrl.run." + key] = value;
+    metadata["worldToCamera"] = camera.worldToCamera();
+    metadata["worldToNDC"] = camera.worldToNDC();
+}
+
+}  // namespace vrl

@@ -1,0 +1,62 @@
+#include "render/scene/camera.h"
+
+#include <array>
+
+#include <cmath>
+
+namespace vrl {
+
+PerspectiveCamera::PerspectiveCamera(const SensorDescription& sensor)
+    : worldFromCamera_(sensor.toWorld),
+      position_(sensor.toWorld.applyPoint(Vec3(0.0f))),
+      width_(sensor.width),
+      height_(sensor.height),
+      nearClip_(sensor.nearClip),
+      farClip_(sensor.farClip) {
+    const float w = float(width_), h = float(height_);
+    const float tanHalf = std::tan(sensor.fov * kPi / 360.0f);
+    using Axis = SensorDescription::FovAxis;
+    Axis axis = sensor.fovAxis;
+    if (axis == Axis::Smaller) axis = w <= h ? Axis::X : Axis::Y;
+    if (axis == Axis::Larger) axis = w >= h ? Axis::X : Axis::Y;
+    switch (axis) {
+        case Axis::X: tanHalfX_ = tanHalf; break;
+        case Axis::Y: tanHalfX_ = tanHalf * w / h; break;
+        default: tanHalfX_ = tanHalf * w / std::sqrt(w * w + h * h); break;  // diagonal
+    }
+    tanHalfY_ = tanHalfX_ * h / w;
+}
+
+Ray PerspectiveCamera::generateRay(float filmX, float filmY) const {
+    const float ndcX = 2.0f * filmX / float(width_) - 1.0f;
+    const float ndcY = 2.0f * filmY / float(height_) - 1.0f;
+    const Vec3 local(-ndcX * tanHalfX_, -ndcY * tanHalfY_, 1.0f);
+    const Vec3 dir = worldFromCamera_.applyVector(local).normalized();
+    const float localLength = local.length();  // z = 1: the clip distances scale by this
+    Ray ray{position_ + dir * (nearClip_ * localLength), dir, (farClip_ - nearClip_) * localLength};
+    return ray;
+}
+
+Imath::M44f PerspectiveCamera::worldToCamera() const {
+    const std::array<double, 16> m = worldFromCamera_.inverse().toRowMajor();  // column vectors
+    Imath::M44f out;
+    for (int row = 0; row < 4; ++row)
+        for (int col = 0; col < 4; ++col) out[row][col] = float(m[size_t(4 * col + row)]);  // transpose: row vectors
+    for (int row = 0; row < 4; ++row) out[row][0] = -out[row][0];  // Mitsuba's +x is the image's left
+    return out;
+}
+
+Imath::M44f PerspectiveCamera::worldToNDC() const {
+    // Camera (x right, y up, z forward) to NDC: x/z = tanHalfX at the right edge, y/z = tanHalfY at the top.
+    Imath::M44f projection(0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f,
+                           0.0f);
+    projection[0][0] = 0.5f / tanHalfX_;
+    projection[1][1] = -0.5f / tanHalfY_;
+    projection[2][0] = 0.5f;
+    projection[2][1] = 0.5f;
+    projection[2][2] = 1.0f;
+    projection[2][3] = 1.0f;
+    return worldToCamera() * projection;
+}
+
+}  // namespace vrl

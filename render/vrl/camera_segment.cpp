@@ -1,0 +1,47 @@
+#include "render/vrl/camera_segment.h"
+
+#include "render/core/rng.h"
+#include "render/scene/scene.h"
+
+namespace vrl {
+
+std::vector<CameraSegment> cameraSegments(const Scene& scene, const Ray& cameraRay, int medium, Rng* rng,
+                                          int maxDepth) {
+    std::vector<CameraSegment> segments;
+    Ray ray = cameraRay;
+    Rgb throughput(1.0f);
+    int specular = 0;
+    float segmentStart = ray.tMin;
+    for (int crossings = 0; crossings < 256; ++crossings) {
+        const auto hit = scene.intersect(ray);
+        const float end = hit ? hit->t : ray.tMax;
+        if (medium >= 0 && end > segmentStart) {
+            const float length = std::isfinite(end) ? end - segmentStart : 1e30f;
+            segments.push_back({ray.at(segmentStart), ray.direction, length, medium, throughput, specular});
+            throughput *= scene.media()[medium].transmittance(end - segmentStart);
+        }
+        if (!hit) break;
+        const Bsdf& bsdf = scene.shapes()[hit->shape].bsdf;
+        if (bsdf.isNull()) {
+            medium = scene.mediumAfter(*hit, ray.direction, medium);
+            segmentStart = hit->t;
+            Scene::continuePast(ray, *hit);
+            continue;
+        }
+        // A specular bounce is a path vertex: after it, a medium vertex on the next
+        // segment and a light still need to fit (specular + 1 + 2 segments).
+        if (!rng || !bsdf.isPurelySpecular() || specular >= kMaxSpecularChain) break;
+        if (maxDepth >= 0 && specular + 3 > maxDepth) break;
+        const auto sampled = bsdf.sample(hit->shadingPoint(), -ray.direction, Vec2(rng->next(), rng->next()),
+                                         rng->next(), TransportMode::Radiance);
+        if (!sampled || isBlack(sampled->weight)) break;
+        throughput *= sampled->weight;
+        ++specular;
+        medium = scene.mediumAfter(*hit, sampled->wi, medium);
+        ray = Ray{Scene::offsetOrigin(*hit, sampled->wi), sampled->wi};
+        segmentStart = 0.0f;
+    }
+    return segments;
+}
+
+}  // namespace vrl

@@ -1,0 +1,184 @@
+#include "render/vrl/vrl_estimator.h"
+
+#include "render/scene/scene.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+
+namespace vrl {
+
+namespace {
+
+using V3d = Imath::V3d;
+V3d toDouble(const Vec3& v) { return {v.x, v.y, v.z}; }
+
+// Where the VRL's line comes closest to the camera line: h(v)^2 = h0^2 + s^2 (v - v0)^2.
+struct LinePair {
+    double v0 = 0, h0 = 0, sinTheta = 0;
+    bool parallel = true;
+    double epsilon = 0;  // floor for h0 in the pdf: keeps the pdf proper when the lines cross
+};
+
+LinePair linePair(const Vrl& vrl, const Vec3& lineOrigin, const Vec3& lineDirection) {
+    const V3d w = toDouble(lineDirection), d = toDouble(vrl.direction), r = toDouble(vrl.origin - lineOrigin);
+    const V3d rPerp = r - w * w.dot(r), dPerp = d - w * w.dot(d);
+    LinePair p;
+    p.epsilon = 1e-7 * (1.0 + r.length() + vrl.length);
+    const double s2 = dPerp.length2();
+    if (s2 < 1e-14) {  // parallel within float precision: h is constant
+        p.h0 = rPerp.length();
+        return p;
+    }
+    p.parallel = false;
+    p.sinTheta = std::sqrt(s2);
+    p.v0 = -rPerp.dot(dPerp) / s2;
+    p.h0 = std::sqrt(std::max(0.0, rPerp.length2() - rPerp.dot(dPerp) * rPerp.dot(dPerp) / s2));
+    return p;
+}
+
+struct AsinhRange {
+    double a0, a1, h;
+};
+AsinhRange asinhRange(const LinePair& p, double length) {
+    const double h = std::max(p.h0, p.epsilon);
+    return {std::asinh(p.sinTheta * (0.0 - p.v0) / h), std::asinh(p.sinTheta * (length - p.v0) / h), h};
+}
+
+struct Equiangular {
+    double delta, h, thetaA, thetaB;
+};
+Equiangular equiangular(const Vec3& origin, const Vec3& direction, float length, const Vec3& point) {
+    const V3d w = toDouble(direction), r = toDouble(point - origin);
+    const double delta = w.dot(r);
+    const double distance = (r - w * delta).length();
+    // Floor against exact hits on the line, relative to the point's own scale (not the
+    // segment's: a ray leaving an unbounded medium is 1e30 long).
+    const double h = std::max(distance, 1e-7 * (1.0 + r.length()));
+    return {delta, h, std::atan2(0.0 - delta, h), std::atan2(double(length) - delta, h)};
+}
+
+}  // namespace
+
+DistanceSample sampleVrlPoint(const Vrl& vrl, const Vec3& lineOrigin, const Vec3& lineDirection, float xi) {
+    if (!(vrl.length > 0.0f)) return {};
+    const LinePair p = linePair(vrl, lineOrigin, lineDirection);
+    if (p.parallel) return {xi * vrl.length, 1.0f / vrl.length};
+    const AsinhRange a = asinhRange(p, vrl.length);
+    if (!(a.a1 > a.a0)) return {xi * vrl.length, 1.0f / vrl.length};
+    // Round to the float returned first, so the pdf is that of the point returned.
+    const double v = double(std::clamp(float(p.v0 + a.h / p.sinTheta * std::sinh(a.a0 + xi * (a.a1 - a.a0))), 0.0f,
+                                       vrl.length));
+    const double pdf = p.sinTheta / ((a.a1 - a.a0) * std::sqrt(a.h * a.h + p.sinTheta * p.sinTheta * (v - p.v0) * (v - p.v0)));
+    return {float(v), float(pdf)};
+}
+
+float vrlPointPdf(const Vrl& vrl, const Vec3& lineOrigin, const Vec3& lineDirection, float v) {
+    if (!(vrl.length > 0.0f) || v < 0.0f || v > vrl.length) return 0.0f;
+    const LinePair p = linePair(vrl, lineOrigin, lineDirection);
+    if (p.parallel) return 1.0f / vrl.length;
+    const AsinhRange a = asinhRange(p, vrl.length);
+    if (!(a.a1 > a.a0)) return 1.0f / vrl.length;
+    return float(p.sinTheta / ((a.a1 - a.a0) * std::sqrt(a.h * a.h + p.sinTheta * p.sinTheta * (v - p.v0) * (v - p.v0))));
+}
+
+DistanceSample sampleEquiangular(const Vec3& origin, const Vec3& direction, float length, const Vec3& point,
+                                 float xi) {
+    if (!(length > 0.0f)) return {};
+    const Equiangular e = equiangular(origin, direction, length, point);
+    if (!(e.thetaB > e.thetaA)) return {xi * length, 1.0f / length};
+    const double u =
+        double(std::clamp(float(e.delta + e.h * std::tan(e.thetaA + xi * (e.thetaB - e.thetaA))), 0.0f, length));
+    const double pdf = e.h / ((e.thetaB - e.thetaA) * (e.h * e.h + (u - e.delta) * (u - e.delta)));
+    return {float(u), float(pdf)};
+}
+
+float equiangularPdf(const Vec3& origin, const Vec3& direction, float length, const Vec3& point, float u) {
+    if (!(length > 0.0f) || u < 0.0f || u > length) return 0.0f;
+    const Equiangular e = equiangular(origin, direction, length, point);
+    if (!(e.thetaB > e.thetaA)) return 1.0f / length;
+    return float(e.h / ((e.thetaB - e.thetaA) * (e.h * e.h + (u - e.delta) * (u - e.delta))));
+}
+
+VrlEstimator::VrlEstimator(const Scene& scene, int samplesPerVrl)
+    : scene_(scene), samplesPerVrl_(std::max(1, samplesPerVrl)) {}
+
+Rgb VrlEstimator::contribution(const Vrl& vrl, const CameraSegment& segment, Rng& rng) const {
+    if (!(vrl.length > 0.0f) || !(segment.length > 0.0f)) return Rgb(0.0f);
+    Rgb sum(0.0f);
+    for (int i = 0; i < samplesPerVrl_; ++i) sum += sampleOnce(vrl, segment, rng);
+    return sum / float(samplesPerVrl_);
+}
+
+Rgb VrlEstimator::sampleOnce(const Vrl& vrl, const CameraSegment& segment, Rng& rng) const {
+    const HomogeneousMedium& mediumV = scene_.media()[vrl.medium];
+    const HomogeneousMedium& mediumU = scene_.media()[segment.medium];
+    const DistanceSample vs = sampleVrlPoint(vrl, segment.origin, segment.direction, rng.next());
+    if (!(vs.pdf > 0.0f)) return Rgb(0.0f);
+    const Vec3 xv = vrl.origin + vrl.direction * vs.t;
+
+    // u | v: equiangular from xv, or for anisotropic media a mixture of that with a
+    // piecewise-constant fit of f(u) f(v) over kBins bins of the equiangular angle.
+    const Equiangular e = equiangular(segment.origin, segment.direction, segment.length, xv);
+    const double span = e.thetaB - e.thetaA;
+    if (!(span > 0.0)) return Rgb(0.0f);
+    const bool anisotropic = !mediumU.phase().isIsotropic() || !mediumV.phase().isIsotropic();
+    constexpr int kBins = 8;
+    constexpr double kUniformWeight = 0.25;
+    std::array<double, kBins> binWeight{};
+    double binTotal = 0.0;
+    double theta;
+    if (anisotropic) {
+        // In the plane of the camera line and xv, the direction from xv to u(theta) is
+        // w sin(theta) - e cos(theta), e the unit offset of xv from the line: so
+        // cos to the VRL = sin(theta) (d.w) - cos(theta) (d.e), cos to the camera = -sin(theta).
+        const Vec3 foot = segment.origin + segment.direction * float(e.delta);
+        const Vec3 offset = xv - foot;
+        const float offsetLength = offset.length();
+        const Vec3 unitOffset = offsetLength > 0.0f ? offset / offsetLength : Frame::fromNormal(segment.direction).s;
+        const double dw = vrl.direction.dot(segment.direction), de = vrl.direction.dot(unitOffset);
+        const double step = span / kBins;
+        double c = std::cos(e.thetaA + 0.5 * step), s = std::sin(e.thetaA + 0.5 * step);
+        const double cStep = std::cos(step), sStep = std::sin(step);
+        for (int b = 0; b < kBins; ++b) {
+            binWeight[b] = double(mediumV.phase().evalCosine(float(s * dw - c * de)) * mediumU.phase().evalCosine(float(-s)));
+            binTotal += binWeight[b];
+            const double cNext = c * cStep - s * sStep;
+            s = s * cStep + c * sStep;
+            c = cNext;
+        }
+    }
+    if (anisotropic && binTotal > 0.0 && rng.next() >= kUniformWeight) {
+        double target = rng.next() * binTotal;
+        int b = 0;
+        while (b < kBins - 1 && target >= binWeight[b]) target -= binWeight[b++];
+        theta = e.thetaA + (b + rng.next()) * span / kBins;
+    } else {
+        theta = e.thetaA + rng.next() * span;
+    }
+    theta = std::clamp(theta, e.thetaA, e.thetaB);
+    double thetaPdf = 1.0 / span;  // density in the angle
+    if (anisotropic && binTotal > 0.0) {
+        const int b = std::min(kBins - 1, int((theta - e.thetaA) / span * kBins));
+        thetaPdf = kUniformWeight / span + (1.0 - kUniformWeight) * binWeight[b] / binTotal * kBins / span;
+    }
+    const double u = double(std::clamp(float(e.delta + e.h * std::tan(theta)), 0.0f, segment.length));
+    const double uPdf = thetaPdf * e.h / (e.h * e.h + (u - e.delta) * (u - e.delta));
+
+    const Vec3 xu = segment.origin + segment.direction * float(u);
+    const Vec3 d = xu - xv;
+    const float w2 = d.length2();
+    if (!(w2 > 0.0f)) return Rgb(0.0f);
+    const float w = std::sqrt(w2);
+    const Vec3 toU = d / w;
+    const float phase = mediumV.phase().eval(vrl.direction, toU) * mediumU.phase().eval(toU, -segment.direction);
+    const Rgb cameraTransmittance = segment.throughputBefore * mediumU.transmittance(float(u));
+    const Rgb between = vrl.medium == segment.medium && !scene_.mediumNeedsVisibility(segment.medium)
+                            ? mediumU.transmittance(w)
+                            : scene_.transmittance(xu, xv, segment.medium);
+    if (isBlack(between)) return Rgb(0.0f);
+    const double scale = double(phase) / (double(w2) * double(vs.pdf) * uPdf);
+    return vrl.flux * mediumV.sigmaS() * mediumU.sigmaS() * cameraTransmittance * between * float(scale);
+}
+
+}  // namespace vrl

@@ -1,0 +1,53 @@
+// VrlEstimator: the contribution of one short VRL to one camera segment,
+// Eq. 5 of Vibert et al. 2019 (Novak et al. 2012's joint importance sampling):
+//   Phi sigma_s(v) f(v) sigma_s(u) f(u) T_r(u) T_r(w) V / (w^2 p(v) p(u|v)),
+// with v on the VRL drawn with pdf proportional to 1/h(v) (h: distance to the
+// camera ray's line; inverse CDF through asinh/sinh), then u on the camera
+// segment by equiangular sampling from v. Isotropic media cancel the geometric
+// term exactly; anisotropic (HG) media draw u from a piecewise-constant
+// approximation of f(u) f(v) in the equiangular angle, mixed with the
+// isotropic strategy (no tables are built for isotropic media).
+// Degenerate configurations (parallel, crossing, touching, zero length) fall
+// back to limiting pdfs: results stay finite and unbiased.
+#pragma once
+
+#include "render/core/rng.h"
+#include "render/vrl/camera_segment.h"
+#include "render/vrl/vrl.h"
+
+namespace vrl {
+
+class Scene;
+
+struct DistanceSample {
+    float t = 0.0f;    // parameter along the line
+    float pdf = 0.0f;  // per unit length; 0 if the interval is empty
+};
+
+// v on [0, vrl.length] with pdf proportional to 1/h(v), h = distance to the line
+// (lineOrigin, lineDirection). Parallel lines: uniform.
+DistanceSample sampleVrlPoint(const Vrl& vrl, const Vec3& lineOrigin, const Vec3& lineDirection, float xi);
+float vrlPointPdf(const Vrl& vrl, const Vec3& lineOrigin, const Vec3& lineDirection, float v);
+
+// u on [0, length] of the segment with pdf proportional to 1/|x(u) - point|^2.
+DistanceSample sampleEquiangular(const Vec3& origin, const Vec3& direction, float length, const Vec3& point,
+                                 float xi);
+float equiangularPdf(const Vec3& origin, const Vec3& direction, float length, const Vec3& point, float u);
+
+class VrlEstimator {
+public:
+    // samplesPerVrl: (u, v) pairs averaged per VRL and segment.
+    VrlEstimator(const Scene& scene, int samplesPerVrl);
+
+    // One estimate of the VRL's radiance contribution to the segment's origin end
+    // (already multiplied by the segment's throughputBefore).
+    Rgb contribution(const Vrl& vrl, const CameraSegment& segment, Rng& rng) const;
+
+private:
+    Rgb sampleOnce(const Vrl& vrl, const CameraSegment& segment, Rng& rng) const;
+
+    const Scene& scene_;
+    int samplesPerVrl_;
+};
+
+}  // namespace vrl

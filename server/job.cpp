@@ -1,0 +1,43 @@
+#include "server/job.h"
+
+#include "render/core/timing.h"
+
+namespace vrl::server {
+
+bool isTerminal(v1::JobState state) {
+    return state == v1::JOB_STATE_DONE || state == v1::JOB_STATE_FAILED || state == v1::JOB_STATE_CANCELLED;
+}
+
+v1::JobProgress progressOf(const Job& job) {
+    v1::JobProgress p;
+    p.set_job_id(job.id);
+    p.set_state(job.state);
+    p.set_name(job.spec.name());
+    p.set_priority(job.spec.priority());
+    p.set_message(job.message);
+    p.set_tiles_total(uint32_t(job.tiles.size()));
+    p.set_tiles_done(job.doneCount);
+    p.set_preparing_fraction(job.preparingFraction);
+    double eta = -1.0;
+    if (job.state == v1::JOB_STATE_RENDERING && job.doneCount > job.doneAtStart) {
+        const double elapsed = secondsSince(job.renderStart);
+        eta = elapsed / double(job.doneCount - job.doneAtStart) * double(job.tiles.size() - job.doneCount);
+    } else if (job.state == v1::JOB_STATE_DONE) {
+        eta = 0.0;
+    }
+    p.set_eta_seconds(eta);
+    for (const auto& [name, share] : job.workers) {
+        auto* w = p.add_workers();
+        w->set_worker(name);
+        w->set_tiles(share.tiles);
+        w->set_pixels_per_second(share.seconds > 0.0 ? double(share.pixels) / share.seconds : 0.0);
+    }
+    for (const auto& [phase, seconds] : job.phases) {
+        auto* t = p.add_phases();
+        t->set_phase(phase);
+        t->set_seconds(seconds);
+    }
+    return p;
+}
+
+}  // namespace vrl::server

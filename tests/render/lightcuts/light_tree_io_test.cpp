@@ -1,0 +1,247 @@
+#include "render/lightcuts/light_tree_io.h"
+
+#include "render/core/rng.h"
+
+#include <gtest/gtest.h>
+
+#include <zlib.h>
+
+#include <algorithm>
+#include <bit>
+#include <cstdint>
+#include <functional>
+#include <stdexcept>
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace vrl {
+namespace {
+
+constexpr size_t kHeaderBytes = 24, kVrlBytes = 44, kNodeBytes = 72;
+
+uint32_t bits(float f) { return std::bit_cast<uint32_t>(f); }
+
+void expectSameBits(const Imath::V3f& a, const Imath::V3f& b, const std::string& what) {
+    for (int k = 0; k < 3; ++k) EXPECT_EQ(bits(a[k]), bits(b[k])) << what << "[" << k << "]";
+}
+
+// Field by field (no memcmp over padding), floats by bit pattern.
+void expectSameTree(const LightTree& a, const LightTree& b) {
+    ASSERT_EQ(a.root(), b.root());
+    ASSERT_EQ(a.vrls().size(), b.vrls().size());
+    ASSERT_EQ(a.nodes().size(), b.nodes().size());
+    for (size_t i = 0; i < a.vrls().size(); ++i) {
+        const Vrl &x = a.vrls()[i], &y = b.vrls()[i];
+        const std::string at = "vrl " + std::to_string(i) + " ";
+        expectSameBits(x.origin, y.origin, at + "origin");
+        expectSameBits(x.direction, y.direction, at + "direction");
+        EXPECT_EQ(bits(x.length), bits(y.length)) << at;
+        expectSameBits(x.flux, y.flux, at + "flux");
+        EXPECT_EQ(x.medium, y.medium) << at;
+    }
+    for (size_t i = 0; i < a.nodes().size(); ++i) {
+        const LightTreeNode &x = a.nodes()[i], &y = b.nodes()[i];
+        const std::string at = "node " + std::to_string(i) + " ";
+        expectSameBits(x.box.min, y.box.min, at + "box.min");
+        expectSameBits(x.box.max, y.box.max, at + "box.max");
+        expectSameBits(x.fluxLength, y.fluxLength, at + "fluxLength");
+        expectSameBits(x.clusterFlux, y.clusterFlux, at + "clusterFlux");
+        EXPECT_EQ(bits(x.maxLength), bits(y.maxLength)) << at;
+        EXPECT_EQ(x.representative, y.representative) << at;
+        EXPECT_EQ(x.vrlCount, y.vrlCount) << at;
+        EXPECT_EQ(x.left, y.left) << at;
+        EXPECT_EQ(x.right, y.right) << at;
+        EXPECT_EQ(x.medium, y.medium) << at;
+    }
+}
+
+void expectRoundTrip(const LightTree& tree) {
+    const std::vector<uint8_t> blob = serializeLightTree(tree);
+    EXPECT_EQ(blob.size(), kHeaderBytes + kVrlBytes * tree.vrls().size() + kNodeBytes * tree.nodes().size() + 4);
+    const LightTree back = deserializeLightTree(blob);
+    expectSameTree(tree, back);
+    EXPECT_EQ(serializeLightTree(back), blob);
+}
+
+// A consistent tree by hand: leaves are VRLs 0..n-1, then one inner node per
+// (left, right) merge, in order; the root is the last node.
+LightTree makeTree(std::vector<Vrl> vrls, const std::vector<std::pair<int32_t, int32_t>>& merges) {
+    std::vector<LightTreeNode> nodes;
+    for (size_t i = 0; i < vrls.size(); ++i) {
+        const Vrl& v = vrls[i];
+        LightTreeNode n;
+        n.box.extendBy(v.origin);
+        n.box.extendBy(v.end());
+        n.fluxLength = v.flux * v.length;
+        n.clusterFlux = v.flux;
+        n.maxLength = v.length;
+        n.representative = uint32_t(i);
+        n.vrlCount = 1;
+        n.medium = v.medium;
+        nodes.push_back(n);
+    }
+    for (auto [l, r] : merges) {
+        const LightTreeNode a = nodes[l], b = nodes[r];
+        LightTreeNode n;
+        n.box = a.box;
+        n.box.extendBy(b.box);
+        n.fluxLength = a.fluxLength + b.fluxLength;
+        n.representative = a.representative;
+        n.clusterFlux = n.fluxLength / vrls[n.representative].length;
+        n.maxLength = std::max(a.maxLength, b.maxLength);
+        n.vrlCount = a.vrlCount + b.vrlCount;
+        n.left = l, n.right = r;
+        n.medium = a.medium == b.medium ? a.medium : -1;
+        nodes.push_back(n);
+    }
+    const auto root = vrls.empty() ? -1 : int32_t(nodes.size()) - 1;
+    return LightTree::fromParts(std::move(vrls), std::move(nodes), root);
+}
+
+Vrl randomVrl(Rng& rng) {
+    Vrl v;
+    v.origin = {rng.next() * 4 - 2, rng.next() * 4 - 2, rng.next() * 4 - 2};
+    v.direction = Vec3(rng.next() - 0.5f, rng.next() - 0.5f, rng.next() - 0.5f).normalized();
+    v.length = 0.01f + rng.next();
+    v.flux = {rng.next(), rng.next(), rng.next()};
+    v.medium = int32_t(rng.nextUint() % 3);
+    return v;
+}
+
+// Three leaves and two inner nodes: ((0, 1), 2).
+LightTree smallTree() {
+    Rng rng(7, 0);
+    return makeTree({randomVrl(rng), randomVrl(rng), randomVrl(rng)}, {{0, 1}, {3, 2}});
+}
+
+void putU32(std::vector<uint8_t>& blob, size_t offset, uint32_t v) {
+    for (int i = 0; i < 4; ++i) blob[offset + i] = uint8_t(v >> (8 * i));
+}
+void resealCrc(std::vector<uint8_t>& blob) {
+    putU32(blob, blob.size() - 4, uint32_t(crc32(0L, blob.data(), uInt(blob.size() - 4))));
+}
+
+// Expects a std::runtime_error whose message contains every one of `parts`.
+void expectRejected(const std::vector<uint8_t>& blob, const std::vector<std::string>& parts,
+                    const std::string& context = "") {
+    try {
+        deserializeLightTree(blob);
+        ADD_FAILURE() << "accepted a bad blob " << context;
+    } catch (const std::runtime_error& e) {
+        for (const std::string& part : parts)
+            EXPECT_NE(std::string(e.what()).find(part), std::string::npos)
+                << "message \"" << e.what() << "\" lacks \"" << part << "\" " << context;
+    }
+}
+
+TEST(LightTreeIo, SingleLeafRoundTripsBitExactly) {
+    Vrl v;
+    v.origin = {-0.0f, 1.5f, 0.0f};
+    v.direction = {0.0f, -0.0f, 1.0f};
+    v.length = 0.25f;
+    v.flux = {3.0f, std::bit_cast<float>(0x7fc12345u), std::bit_cast<float>(0xffa00001u)};  // NaN payloads
+    v.medium = 2;
+    expectRoundTrip(makeTree({v}, {}));
+}
+
+TEST(LightTreeIo, ThreeLeavesTwoInnerNodesRoundTrip) { expectRoundTrip(smallTree()); }
+
+TEST(LightTreeIo, RandomTreeOfHundredsOfVrlsRoundTrips) {
+    Rng rng(20240611, 1);  // seed, stream
+    std::vector<Vrl> vrls;
+    for (int i = 0; i < 317; ++i) vrls.push_back(randomVrl(rng));
+    // Random binary tree: merge two random subtrees until one remains.
+    std::vector<int32_t> open;
+    for (int32_t i = 0; i < int32_t(vrls.size()); ++i) open.push_back(i);
+    std::vector<std::pair<int32_t, int32_t>> merges;
+    for (int32_t next = int32_t(vrls.size()); open.size() > 1; ++next) {
+        std::swap(open[rng.nextUint() % open.size()], open.back());
+        const int32_t a = open.back();
+        open.pop_back();
+        std::swap(open[rng.nextUint() % open.size()], open.back());
+        merges.push_back({a, open.back()});
+        open.back() = next;
+    }
+    const LightTree tree = makeTree(std::move(vrls), merges);
+    ASSERT_EQ(tree.nodes()[size_t(tree.root())].vrlCount, 317u);
+    expectRoundTrip(tree);
+}
+
+TEST(LightTreeIo, EmptyTreeRoundTrips) {
+    expectRoundTrip(LightTree());
+    EXPECT_TRUE(deserializeLightTree(serializeLightTree(LightTree())).empty());
+}
+
+TEST(LightTreeIo, LayoutIsLittleEndianFieldByField) {
+    const std::vector<uint8_t> blob = serializeLightTree(smallTree());
+    EXPECT_EQ(std::string(blob.begin(), blob.begin() + 8), std::string("VRLTREE\0", 8));
+    const std::vector<uint8_t> counts(blob.begin() + 8, blob.begin() + 24);
+    EXPECT_EQ(counts, (std::vector<uint8_t>{kLightTreeFormatVersion, 0, 0, 0, 3, 0, 0, 0, 5, 0, 0, 0, 4, 0, 0, 0}));
+}
+
+TEST(LightTreeIo, RejectsWrongMagic) {
+    std::vector<uint8_t> blob = serializeLightTree(smallTree());
+    blob[3] = 'X';
+    expectRejected(blob, {"not a VRL light tree"});
+    expectRejected({'P', 'K', 3}, {"not a VRL light tree"});
+}
+
+TEST(LightTreeIo, RejectsOtherFormatVersionNamingBoth) {
+    std::vector<uint8_t> blob = serializeLightTree(smallTree());
+    putU32(blob, 8, kLightTreeFormatVersion + 1);
+    resealCrc(blob);
+    expectRejected(blob, {"version " + std::to_string(kLightTreeFormatVersion + 1),
+                          "version " + std::to_string(kLightTreeFormatVersion)});
+}
+
+TEST(LightTreeIo, RejectsEveryTruncation) {
+    const std::vector<uint8_t> blob = serializeLightTree(smallTree());
+    for (size_t n = 0; n < blob.size(); ++n) {
+        // A copy of exactly n bytes, so a sanitizer sees any read past its end.
+        const std::vector<uint8_t> cut(blob.begin(), blob.begin() + n);
+        expectRejected(cut, {"truncated", "expected", "found " + std::to_string(n)}, "at " + std::to_string(n));
+    }
+}
+
+TEST(LightTreeIo, RejectsTrailingBytes) {
+    std::vector<uint8_t> blob = serializeLightTree(smallTree());
+    blob.push_back(0);
+    expectRejected(blob, {"longer than expected", "found " + std::to_string(blob.size())});
+}
+
+TEST(LightTreeIo, RejectsEveryFlippedBit) {
+    const std::vector<uint8_t> blob = serializeLightTree(smallTree());
+    for (size_t byte = 0; byte < blob.size(); ++byte) {
+        for (int bit = 0; bit < 8; ++bit) {
+            std::vector<uint8_t> bad = blob;
+            bad[byte] ^= uint8_t(1u << bit);
+            // The magic, version and counts fields have their own messages; past them, the checksum.
+            const bool pastCounts = byte >= 20;
+            expectRejected(bad, pastCounts ? std::vector<std::string>{"checksum"} : std::vector<std::string>{},
+                           "flipping byte " + std::to_string(byte) + " bit " + std::to_string(bit));
+        }
+    }
+}
+
+TEST(LightTreeIo, RejectsHugeCountsWithoutAllocating) {
+    for (uint32_t nodes : {5u, 0xffffffffu}) {
+        std::vector<uint8_t> blob = serializeLightTree(smallTree());
+        putU32(blob, 12, 1u << 31);
+        putU32(blob, 16, nodes);
+        resealCrc(blob);
+        // Allocating 2^31 VRLs (94 GB) first would throw std::bad_alloc or die, not this.
+        expectRejected(blob, {"2147483648 VRLs", "found " + std::to_string(blob.size()) + " bytes"});
+    }
+}
+
+TEST(LightTreeIo, RejectsStructurallyInvalidTreeWithValidChecksum) {
+    std::vector<uint8_t> blob = serializeLightTree(smallTree());
+    const size_t rootNode = kHeaderBytes + 3 * kVrlBytes + 4 * kNodeBytes;
+    putU32(blob, rootNode + 60, 99);  // `left` of the root (after 13 floats and 2 uint32s): out of range
+    resealCrc(blob);
+    expectRejected(blob, {"structurally invalid", "out of range"});
+}
+
+}  // namespace
+}  // namespace vrl

@@ -1,0 +1,89 @@
+// Error control of VRL Lightcuts: over the same VRLs and seeds, the Lightcuts
+// image of part (d) differs from the plain-VRL image by a relative RMSE that
+// shrinks with the error threshold and stays below the threshold itself (the
+// threshold bounds each refined node's error relative to the pixel's total, and
+// the errors of a cut's nodes partly cancel). Both methods draw VRL k's sample
+// from the same stream, so at threshold 0 they agree to float rounding.
+#include "render/image/image_metrics.h"
+#include "render/renderer.h"
+#include "render/scene_io/mitsuba/mitsuba_parser.h"
+#include "tests/support/test_scenes.h"
+
+#include <gtest/gtest.h>
+#include <tbb/task_arena.h>
+
+#include <cstring>
+#include <filesystem>
+
+namespace vrl {
+namespace {
+
+RenderSettings multipleScattering(RenderMethod method, float error) {
+    RenderSettings settings;
+    settings.method = method;
+    settings.transports = TransportSelection::parse("multiple");
+    settings.vrlCount = 6000;
+    settings.seed = 3;
+    settings.cut.errorThreshold = error;
+    settings.cut.maxCutSize = 1u << 30;  // no safety valve: measure the bound's control alone
+    return settings;
+}
+
+void expectErrorControl(const Scene& scene, const char* name) {
+    const Image plain = render(scene, multipleScattering(RenderMethod::Vrl, 0.0f)).image;
+    double previous = 1e30;
+    for (float error : {0.1f, 0.03f, 0.01f}) {
+        const ImageSet cut = render(scene, multipleScattering(RenderMethod::VrlLightcuts, error));
+        const ImageErrorMetrics m = compareImages(plain, cut.image);
+        std::printf("%s: threshold %.3f -> relative RMSE %.5f against plain VRLs\n", name, error, m.relativeRmse);
+        EXPECT_LT(m.relativeRmse, error) << name << " threshold " << error;
+        EXPECT_LT(m.relativeRmse, previous) << name << ": error must shrink with the threshold";
+        previous = m.relativeRmse;
+    }
+    const ImageSet exact = render(scene, multipleScattering(RenderMethod::VrlLightcuts, 0.0f));
+    EXPECT_LT(compareImages(plain, exact.image).relativeRmse, 1e-4) << name << ": threshold 0 refines to every VRL";
+}
+
+TEST(Lightcuts, ErrorShrinksWithThresholdOnDefaultScene) {
+    SceneDescription d = parseMitsubaScene(std::filesystem::path(VRL_TEST_DATA_DIR) / "../scenes/smoke-room.xml");
+    d.sensor.width = 24;
+    d.sensor.height = 18;
+    const auto scene = Scene::build(d);
+    expectErrorControl(*scene, "smoke-room");
+}
+
+TEST(Lightcuts, ErrorShrinksWithThresholdInLitRoom) {
+    const auto scene = Scene::build(test::litRoomWithOccluder(Rgb(0.4f), Rgb(0.1f), 0.0f));
+    expectErrorControl(*scene, "lit room");
+}
+
+TEST(Lightcuts, StatisticsLayersAndDeterminism) {
+    const auto scene = Scene::build(test::litRoomWithOccluder(Rgb(0.4f), Rgb(0.1f), 0.0f));
+    RenderSettings settings = multipleScattering(RenderMethod::VrlLightcuts, 0.02f);
+    settings.tileSize = 5;
+    RenderStatistics stats;
+    ImageSet one, two;
+    tbb::task_arena(1).execute([&] { one = render(*scene, settings, {}, &stats); });
+    tbb::task_arena(2).execute([&] { two = render(*scene, settings); });
+    EXPECT_EQ(std::memcmp(one.image.pixels().data(), two.image.pixels().data(), one.image.pixelCount() * sizeof(Rgb)), 0);
+    ASSERT_EQ(one.layers.size(), 4u);  // multiple, eval, inter, cut
+    EXPECT_EQ(one.layers[1].first, "eval");
+    EXPECT_EQ(one.layers[2].first, "inter");
+    EXPECT_EQ(one.layers[3].first, "cut");
+    double eval = 0, cut = 0;
+    for (size_t i = 0; i < one.image.pixelCount(); ++i) {
+        eval += one.layers[1].second[i].x;
+        cut += one.layers[3].second[i].x;
+        // Every node in the cut was evaluated at some point.
+        EXPECT_GE(one.layers[1].second[i].x, one.layers[3].second[i].x);
+    }
+    const double n = double(one.image.pixelCount());
+    EXPECT_NEAR(stats.meanEvaluated, eval / n, 1e-9 * eval);
+    EXPECT_NEAR(stats.meanCutSize, cut / n, 1e-9 * cut);
+    EXPECT_GT(stats.meanCutSize, 1.0);
+    EXPECT_LT(stats.meanCutSize, double(stats.vrlCount)) << "a cut smaller than all VRLs is the point";
+    EXPECT_GT(stats.treeBytes, 0u);
+}
+
+}  // namespace
+}  // namespace vrl

@@ -1,0 +1,166 @@
+// Tests of PerspectiveCamera against Mitsuba's perspective sensor: the image
+// orientation (+x camera space is the image's left, +y its top), the field of
+// view along each fovAxis, and the near/far clip planes.
+#include "render/scene/camera.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <tuple>
+#include <utility>
+
+namespace vrl {
+namespace {
+
+using FovAxis = SensorDescription::FovAxis;
+
+// A camera at (1, 2, 3) looking along (0.6, 0.8, 0) with +z up: a frame with no
+// axis aligned to the world's, so a swapped or negated axis shows.
+SensorDescription tiltedSensor(int width, int height, float fov, FovAxis axis) {
+    SensorDescription sensor;
+    sensor.toWorld = Transform::lookAt(Vec3(1, 2, 3), Vec3(4, 6, 3), Vec3(0, 0, 1));
+    sensor.width = width;
+    sensor.height = height;
+    sensor.fov = fov;
+    sensor.fovAxis = axis;
+    return sensor;
+}
+
+Vec3 cameraSpace(const SensorDescription& sensor, const Vec3& worldDirection) {
+    return sensor.toWorld.inverse().applyVector(worldDirection);
+}
+
+// Angle (radians) between a ray and the camera's viewing axis, in double.
+double angleToAxis(const SensorDescription& sensor, const Ray& ray) {
+    const Vec3 local = cameraSpace(sensor, ray.direction);
+    return std::atan2(std::hypot(double(local.x), double(local.y)), double(local.z));
+}
+
+double radians(double degrees) { return degrees * M_PI / 180.0; }
+
+TEST(CameraTest, CentreOfAnOddFilmLooksAlongPlusZ) {
+    const auto sensor = tiltedSensor(5, 3, 50.0f, FovAxis::X);
+    const PerspectiveCamera camera(sensor);
+    EXPECT_EQ(camera.width(), 5);
+    EXPECT_EQ(camera.height(), 3);
+    EXPECT_LT((camera.position() - Vec3(1, 2, 3)).length(), 1e-6f);
+    const Ray ray = camera.generateRay(2.5f, 1.5f);  // the centre of pixel (2, 1)
+    EXPECT_LT((ray.direction - Vec3(0.6f, 0.8f, 0.0f)).length(), 1e-6f);
+    EXPECT_LT((sensor.toWorld.applyVector(Vec3(0, 0, 1)) - Vec3(0.6f, 0.8f, 0.0f)).length(), 1e-6f);
+}
+
+TEST(CameraTest, ImageLeftIsPlusXAndImageTopIsPlusY) {
+    const auto sensor = tiltedSensor(5, 3, 50.0f, FovAxis::X);
+    const PerspectiveCamera camera(sensor);
+    const double tanHalfX = std::tan(radians(25.0)), tanHalfY = tanHalfX * 3.0 / 5.0;
+    // Pixel (0, 1): ndc x = 2 * 0.5 / 5 - 1 = -0.8, so the camera-space direction is
+    // proportional to (+0.8 tanHalfX, 0, 1).
+    const Vec3 left = cameraSpace(sensor, camera.generateRay(0.5f, 1.5f).direction);
+    EXPECT_GT(left.x, 0.0f);
+    EXPECT_NEAR(left.x / left.z, 0.8 * tanHalfX, 1e-5);
+    EXPECT_NEAR(left.y, 0.0f, 1e-6f);
+    // Pixel (4, 1) is on the right: negative x.
+    EXPECT_NEAR(cameraSpace(sensor, camera.generateRay(4.5f, 1.5f).direction).x / left.z, -0.8 * tanHalfX, 1e-5);
+    // Pixel (2, 0): ndc y = 2 * 0.5 / 3 - 1 = -2/3, direction ~ (0, +2/3 tanHalfY, 1).
+    const Vec3 top = cameraSpace(sensor, camera.generateRay(2.5f, 0.5f).direction);
+    EXPECT_GT(top.y, 0.0f);
+    EXPECT_NEAR(top.y / top.z, 2.0 / 3.0 * tanHalfY, 1e-5);
+    EXPECT_NEAR(top.x, 0.0f, 1e-6f);
+    // In world terms (lookat: +x = up x dir): image left is (-0.8, 0.6, 0), top is +z.
+    EXPECT_GT(camera.generateRay(0.5f, 1.5f).direction.dot(Vec3(-0.8f, 0.6f, 0.0f)), 0.1f);
+    EXPECT_GT(camera.generateRay(2.5f, 0.5f).direction.z, 0.1f);
+}
+
+struct FovCase {
+    FovAxis axis;
+    int width, height;
+    float filmX, filmY;  // a film position on the edge (or corner) along the fov's axis
+};
+
+TEST(CameraTest, FieldOfViewSpansTheChosenAxis) {
+    const float fov = 64.0f;
+    const FovCase cases[] = {
+        {FovAxis::X, 40, 30, 0.0f, 15.0f},         {FovAxis::X, 30, 40, 30.0f, 20.0f},
+        {FovAxis::Y, 40, 30, 20.0f, 0.0f},         {FovAxis::Y, 30, 40, 15.0f, 40.0f},
+        {FovAxis::Diagonal, 40, 30, 0.0f, 0.0f},   {FovAxis::Diagonal, 30, 40, 30.0f, 40.0f},
+        {FovAxis::Smaller, 40, 30, 20.0f, 0.0f},   {FovAxis::Smaller, 30, 40, 0.0f, 20.0f},
+        {FovAxis::Larger, 40, 30, 0.0f, 15.0f},    {FovAxis::Larger, 30, 40, 15.0f, 0.0f},
+    };
+    for (const FovCase& c : cases) {
+        const auto sensor = tiltedSensor(c.width, c.height, fov, c.axis);
+        const PerspectiveCamera camera(sensor);
+        EXPECT_NEAR(angleToAxis(sensor, camera.generateRay(c.filmX, c.filmY)), radians(fov / 2), 2e-6)
+            << "axis " << int(c.axis) << ", film " << c.width << "x" << c.height;
+    }
+}
+
+TEST(CameraTest, OtherAxisFollowsTheAspectRatio) {
+    // fov 90 along x on a 40x30 film: tan(half fov y) = 30/40; along y on 30x40: tan(half fov x) = 30/40.
+    auto sensor = tiltedSensor(40, 30, 90.0f, FovAxis::X);
+    EXPECT_NEAR(angleToAxis(sensor, PerspectiveCamera(sensor).generateRay(20.0f, 0.0f)), std::atan(0.75), 2e-6);
+    sensor = tiltedSensor(30, 40, 90.0f, FovAxis::Y);
+    EXPECT_NEAR(angleToAxis(sensor, PerspectiveCamera(sensor).generateRay(0.0f, 20.0f)), std::atan(0.75), 2e-6);
+    // Diagonal 90 on 40x30: half diagonal tan = 1, so tan(half x) = 0.8, tan(half y) = 0.6.
+    sensor = tiltedSensor(40, 30, 90.0f, FovAxis::Diagonal);
+    const PerspectiveCamera camera(sensor);
+    EXPECT_NEAR(angleToAxis(sensor, camera.generateRay(0.0f, 15.0f)), std::atan(0.8), 2e-6);
+    EXPECT_NEAR(angleToAxis(sensor, camera.generateRay(20.0f, 0.0f)), std::atan(0.6), 2e-6);
+}
+
+TEST(CameraTest, RaysSpanTheClipPlanes) {
+    auto sensor = tiltedSensor(40, 30, 70.0f, FovAxis::X);
+    sensor.nearClip = 0.5f;
+    sensor.farClip = 80.0f;
+    const PerspectiveCamera camera(sensor);
+    const Vec3 axis(0.6f, 0.8f, 0.0f), position(1, 2, 3);
+    for (const auto& [x, y] : {std::pair{20.0f, 15.0f}, std::pair{0.0f, 0.0f}, std::pair{33.3f, 2.5f},
+                               std::pair{40.0f, 30.0f}}) {
+        const Ray ray = camera.generateRay(x, y);
+        EXPECT_NEAR(ray.direction.length(), 1.0f, 1e-6f);
+        const float cosine = ray.direction.dot(axis);
+        ASSERT_GT(cosine, 0.5f);
+        // Origin on the near plane, along the ray from the camera's position.
+        const Vec3 expectedOrigin = position + ray.direction * (sensor.nearClip / cosine);
+        EXPECT_LT((ray.origin - expectedOrigin).length(), 1e-5f) << x << ", " << y;
+        EXPECT_NEAR((ray.origin - position).dot(axis), sensor.nearClip, 1e-5f);
+        // End on the far plane.
+        EXPECT_NEAR(ray.tMax, (sensor.farClip - sensor.nearClip) / cosine, 1e-5f * ray.tMax);
+        EXPECT_NEAR((ray.at(ray.tMax) - position).dot(axis), sensor.farClip, 1e-5f * sensor.farClip);
+        EXPECT_EQ(ray.tMin, 0.0f);
+    }
+}
+
+// OpenEXR's camera attributes: a world point on the ray through film position
+// (fx, fy) maps to NDC (fx / width, fy / height) with w = its camera depth, and
+// worldToCamera puts it on +z with x growing to the image's right.
+TEST(CameraTest, WorldToNdcMapsRayPointsToTheirFilmPosition) {
+    for (const auto& [width, height, axis] : {std::tuple{64, 48, FovAxis::X}, std::tuple{30, 90, FovAxis::Y},
+                                              std::tuple{41, 41, FovAxis::Diagonal}}) {
+        const SensorDescription sensor = tiltedSensor(width, height, 53.0f, axis);
+        const PerspectiveCamera camera(sensor);
+        const Imath::M44f toCamera = camera.worldToCamera(), toNdc = camera.worldToNDC();
+        for (const auto& [fx, fy] : {std::pair{0.5f, 0.5f}, std::pair{float(width) - 0.25f, 3.0f},
+                                     std::pair{float(width) * 0.5f, float(height) * 0.5f}, std::pair{7.0f, float(height)}}) {
+            const Ray ray = camera.generateRay(fx, fy);
+            const Vec3 point = ray.origin + ray.direction * 5.0f;
+            Imath::V4f p(point.x, point.y, point.z, 1.0f);
+            const Imath::V4f ndc = p * toNdc;
+            EXPECT_NEAR(ndc.x / ndc.w, fx / float(width), 1e-5f) << width << "x" << height;
+            EXPECT_NEAR(ndc.y / ndc.w, fy / float(height), 1e-5f) << width << "x" << height;
+            const Imath::V4f c = p * toCamera;
+            EXPECT_GT(c.z, 0.0f);
+            EXPECT_NEAR(c.w, 1.0f, 1e-6f);
+            EXPECT_NEAR(ndc.w, c.z, 1e-4f);
+            // x grows to the image's right in OpenEXR's camera space.
+            if (fx > float(width) * 0.5f + 1.0f) {
+                EXPECT_GT(c.x, 0.0f);
+            }
+            if (fy < float(height) * 0.5f - 1.0f) {
+                EXPECT_GT(c.y, 0.0f);
+            }
+        }
+    }
+}
+
+}  // namespace
+}  // namespace vrl

@@ -1,0 +1,129 @@
+// util/: the leaf helpers against known values (SHA-256 and CRC-32 test
+// vectors), their failure modes (an atomic write that fails leaves the old
+// file and no temporary behind) and their contracts (random ids' alphabet).
+#include "tests/support/temp_dir.h"
+#include "util/atomic_file.h"
+#include "util/hash.h"
+#include "util/random_id.h"
+#include "util/signals.h"
+#include "util/strings.h"
+
+#include <gtest/gtest.h>
+
+#include <pthread.h>
+
+#include <filesystem>
+#include <fstream>
+#include <set>
+#include <sstream>
+#include <stdexcept>
+
+namespace vrl {
+namespace {
+
+namespace fs = std::filesystem;
+
+std::string readAll(const fs::path& path) {
+    std::ifstream in(path, std::ios::binary);
+    std::ostringstream out;
+    out << in.rdbuf();
+    return out.str();
+}
+
+size_t filesIn(const fs::path& dir) {
+    size_t n = 0;
+    for ([[maybe_unused]] const auto& entry : fs::directory_iterator(dir)) ++n;
+    return n;
+}
+
+TEST(UtilHash, Sha256MatchesTheStandardVectors) {
+    EXPECT_EQ(util::sha256Hex(""), "e3b0c44298fc1c149afbf4c8996fb92427ae41e4649b934ca495991b7852b855");
+    EXPECT_EQ(util::sha256Hex("abc"), "ba7816bf8f01cfea414140de5dae2223b00361a396177a9cb410ff61f20015ad");
+    EXPECT_TRUE(util::isSha256Hex(util::sha256Hex("vrl")));
+    EXPECT_FALSE(util::isSha256Hex("BA7816BF8F01CFEA414140DE5DAE2223B00361A396177A9CB410FF61F20015AD"));
+    EXPECT_FALSE(util::isSha256Hex("ba7816bf"));
+    EXPECT_FALSE(util::isSha256Hex(std::string(64, 'g')));
+}
+
+TEST(UtilHash, Crc32MatchesTheCheckValue) {
+    EXPECT_EQ(util::crc32Of("123456789"), 0xCBF43926u);  // the CRC-32 check value
+    EXPECT_EQ(util::crc32Of(""), 0u);
+    const uint8_t bytes[] = {'1', '2', '3', '4', '5', '6', '7', '8', '9'};
+    EXPECT_EQ(util::crc32Of(bytes, sizeof bytes), 0xCBF43926u);
+}
+
+TEST(UtilRandomId, HexDigitsOfTheAskedLengthAndNotRepeated) {
+    std::set<std::string> seen;
+    for (int i = 0; i < 100; ++i) {
+        const std::string id = util::randomHex(16);
+        ASSERT_EQ(id.size(), 16u);
+        for (char c : id) EXPECT_TRUE((c >= '0' && c <= '9') || (c >= 'a' && c <= 'f')) << id;
+        seen.insert(id);
+    }
+    EXPECT_EQ(seen.size(), 100u);  // 64 random bits each: a repeat would mean a broken source
+    EXPECT_EQ(util::randomHex(0), "");
+}
+
+TEST(UtilAtomicFile, WritesWholeFilesAndLeavesNoTemporary) {
+    const test::TempDir dir("vrl-util-atomic");
+    const fs::path file = dir / "out.bin";
+    util::writeFileAtomically(file, std::string("first\0version", 13));
+    EXPECT_EQ(readAll(file), std::string("first\0version", 13));
+    util::writeFileAtomically(file, "second");
+    EXPECT_EQ(readAll(file), "second");
+    EXPECT_EQ(filesIn(dir.path()), 1u);
+    const fs::path sibling = util::temporarySibling(file);
+    EXPECT_EQ(sibling.parent_path(), file.parent_path());
+    EXPECT_NE(sibling, util::temporarySibling(file));
+}
+
+TEST(UtilAtomicFile, AFailedWriteKeepsTheOldFileAndRemovesTheTemporary) {
+    const test::TempDir dir("vrl-util-atomic-fail");
+    const fs::path file = dir / "keep.txt";
+    util::writeFileAtomically(file, "old");
+    EXPECT_THROW(util::writeAtomically(file,
+                                       [](const fs::path& temporary) {
+                                           std::ofstream(temporary) << "half";
+                                           throw std::runtime_error("disk full");
+                                       }),
+                 std::runtime_error);
+    EXPECT_EQ(readAll(file), "old");
+    EXPECT_EQ(filesIn(dir.path()), 1u);
+    // A folder that does not exist: an error naming the file, nothing written.
+    try {
+        util::writeFileAtomically(dir / "no-such-dir" / "x.txt", "data");
+        FAIL() << "writing into a missing folder must throw";
+    } catch (const std::runtime_error& e) {
+        EXPECT_NE(std::string(e.what()).find("no-such-dir"), std::string::npos) << e.what();
+    }
+    EXPECT_EQ(filesIn(dir.path()), 1u);
+}
+
+TEST(UtilStrings, LowerCaseIsAsciiOnly) {
+    EXPECT_EQ(util::toLower("RoughPlastic-GGX"), "roughplastic-ggx");
+    EXPECT_EQ(util::toLower("\xC3\x89t\xC3\xA9"), "\xC3\x89t\xC3\xA9");  // UTF-8 bytes pass through
+    EXPECT_EQ(util::toLower(""), "");
+}
+
+TEST(UtilStrings, AbbreviateKeepsShortTextAndCutsLongText) {
+    EXPECT_EQ(util::abbreviate("job-1"), "job-1");
+    EXPECT_EQ(util::abbreviate(std::string(64, 'x')), std::string(64, 'x'));
+    EXPECT_EQ(util::abbreviate(std::string(100, 'x'), 4), "xxxx... (100 bytes)");
+}
+
+TEST(UtilSignals, BlocksInterruptAndTerminate) {
+    sigset_t before;
+    pthread_sigmask(SIG_SETMASK, nullptr, &before);
+    sigset_t taken;
+    EXPECT_TRUE(util::takeTerminationSignals(taken));  // VRL_EXIT_WITH_PARENT is not set here
+    sigset_t now;
+    pthread_sigmask(SIG_SETMASK, nullptr, &now);
+    EXPECT_TRUE(sigismember(&now, SIGINT));
+    EXPECT_TRUE(sigismember(&now, SIGTERM));
+    EXPECT_TRUE(sigismember(&taken, SIGINT));
+    EXPECT_TRUE(sigismember(&taken, SIGTERM));
+    pthread_sigmask(SIG_SETMASK, &before, nullptr);
+}
+
+}  // namespace
+}  // namespace vrl
