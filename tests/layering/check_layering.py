@@ -8,7 +8,9 @@
   3. server/ and worker/ do not include each other;
   4. render/core/ includes nothing outside render/core/;
   5. util/ includes nothing outside util/ (leaf helpers);
-  6. no cycle between files.
+  6. no cycle between files;
+  7. outside render/scene_io/mitsuba/ (and the tests and fuzzers that probe it),
+     only its public header, mitsuba_parser.h, is included.
 
 Project includes are written from the repository root ("render/core/rgb.h");
 generated API headers ("vrl/v1/vrl.pb.h", "grpc/health/v1/health.pb.h") count
@@ -22,6 +24,8 @@ import sys
 
 SOURCE_EXTENSIONS = ('.h', '.hpp', '.cpp', '.cc')
 SKIP_DIRS = {'.git', 'build', 'docs'}
+MITSUBA_PRIVATE = 'render/scene_io/mitsuba/'
+MITSUBA_PUBLIC = 'render/scene_io/mitsuba/mitsuba_parser.h'
 INCLUDE = re.compile(r'^\s*#\s*include\s*"([^"]+)"')
 
 
@@ -131,6 +135,9 @@ def check(root):
         source_part = part_of(source)
         for number, included in includes:
             problem = violation(source_part, part_of(included))
+            if (not problem and included.startswith(MITSUBA_PRIVATE) and included != MITSUBA_PUBLIC
+                    and not source.startswith((MITSUBA_PRIVATE, 'tests/', 'fuzz/'))):
+                problem = 'only ' + MITSUBA_PUBLIC + ' of render/scene_io/mitsuba/ is public'
             if problem:
                 problems.append('%s:%d: %s (#include "%s")' % (source, number, problem, included))
             if included in files:
