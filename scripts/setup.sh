@@ -12,6 +12,9 @@ packages=(
   libgrpc++-dev libprotobuf-dev protobuf-compiler protobuf-compiler-grpc
   python3 python3-numpy python3-yaml python3-matplotlib openssl iproute2
   clang libclang-rt-dev llvm  # fuzz/: clang++, libFuzzer and sanitizer runtimes, llvm-symbolizer
+  # deploy/smoke.sh: build and run the image with no registry (debootstrap makes the base image);
+  # podman-compose runs deploy/compose.yaml, netavark + aardvark-dns resolve its service names
+  podman buildah runc fuse-overlayfs uidmap debootstrap podman-compose netavark aardvark-dns iptables
 )
 
 missing=()

@@ -16,7 +16,14 @@ Parses every deploy/**/*.yaml|*.yml and deploy/Dockerfile and checks:
   * the compose file has coordinator and worker services, the token comes
     from a compose secret, both have healthchecks and the worker waits for a
     healthy coordinator;
-  * the Dockerfile has at least two FROM lines, the first on debian:12.
+  * the Dockerfile has at least two FROM lines, the first on Debian 12
+    (debian:12, localhost/debian:12 or an ARG defaulting to one); its build
+    stage copies, before compiling, the top-level CMakeLists.txt and every
+    directory it adds with tests off, and never the whole context (so editing
+    deploy/ does not recompile); its last stage installs the package list
+    derived from ldd (no hand-listed lib* packages) and checks ldd;
+  * .dockerignore exists and excludes local state (vrl-state), tokens, build
+    trees and .git.
 
 Prints "checked N files, M documents"; exits 0 on success, 1 on failure.
 Needs only the standard library and PyYAML (python3-yaml).
@@ -112,6 +119,7 @@ class Checker:
             self.check_compose(path, docs)
 
         self.check_dockerfile(self.deploy / "Dockerfile")
+        self.check_dockerignore()
         return self.finish()
 
     def finish(self) -> int:
@@ -381,19 +389,162 @@ class Checker:
             self.fail(path, "missing")
             return
         self.files += 1
-        froms = []
-        for line in path.read_text(encoding="utf-8").splitlines():
-            s = line.strip()
-            if not s or s.startswith("#"):
-                continue
-            words = s.split()
-            if words[0].upper() == "FROM":
-                args = [w for w in words[1:] if not w.startswith("--")]
-                froms.append(args[0] if args else "")
-        if len(froms) < 2:
-            self.fail(path, f"expected a multi-stage build (>= 2 FROM lines), found {len(froms)}")
-        if froms and not re.match(r"^(docker\.io/)?(library/)?debian:12([.\-@]|$)", froms[0]):
-            self.fail(path, f"first stage must be FROM debian:12..., found {froms[0]!r}")
+        stages = dockerfile_stages(path.read_text(encoding="utf-8"))
+        if len(stages) < 2:
+            self.fail(path, f"expected a multi-stage build (>= 2 FROM lines), found {len(stages)}")
+            return
+        first = stages[0]
+        if not re.match(DEBIAN_12, first["base"]):
+            self.fail(path, f"first stage must be FROM debian:12 (or localhost/debian:12, or an ARG "
+                            f"defaulting to one), found {first['from']!r}")
+        self.check_compile_inputs(path, first)
+        self.check_runtime_stage(path, stages[-1])
+
+    def check_compile_inputs(self, path: Path, build):
+        """The build stage copies exactly what the compile reads before compiling.
+
+        A `COPY . ...` would bring deploy/ (and tests/, docs/) into the compile
+        layer, so that editing a manifest recompiles; the named COPYs must then
+        cover every directory the top-level CMakeLists.txt adds with tests off.
+        """
+        copied = set()
+        for kind, args in build["instructions"]:
+            if kind == "RUN" and re.search(r"\bcmake\b", args):
+                break
+            if kind in ("COPY", "ADD"):
+                words = [w for w in args.split() if not w.startswith("--")]
+                if any(w.startswith("--from") for w in args.split()):
+                    continue
+                for src in words[:-1]:
+                    src = src.strip("/") or "."
+                    if src in (".", "*"):
+                        self.fail(path, f"build stage: `{kind} {args}` before the compile copies the whole "
+                                        f"context (deploy/ included): editing deploy/ would recompile")
+                    copied.add(src)
+        else:
+            self.fail(path, "build stage: no `RUN cmake ...` found")
+            return
+        cmake = self.root / "CMakeLists.txt"
+        if not cmake.is_file():
+            return
+        if "CMakeLists.txt" not in copied:
+            self.fail(path, "build stage: CMakeLists.txt is not copied before the compile")
+        for sub in compiled_subdirectories(cmake.read_text(encoding="utf-8")):
+            if sub not in copied:
+                self.fail(path, f"build stage: {sub}/ (add_subdirectory in CMakeLists.txt) is not copied "
+                                f"before the compile")
+
+    def check_runtime_stage(self, path: Path, runtime):
+        """The image installs the derived package list, not a hand-kept one."""
+        runs = [a for k, a in runtime["instructions"] if k == "RUN"]
+        installs = [a for a in runs if "apt-get install" in a]
+        if not any("runtime-packages" in a for a in installs):
+            self.fail(path, "runtime stage: no `apt-get install` of the derived runtime-packages list")
+        for a in installs:
+            listed = [w for w in a.split() if re.match(r"^lib[a-z0-9.+-]+$", w)]
+            if listed:
+                self.fail(path, f"runtime stage: hand-listed packages {listed}: install the derived list instead")
+        if not any("ldd" in a and "not found" in a for a in runs):
+            self.fail(path, "runtime stage: no ldd check for missing shared libraries")
+
+    def check_dockerignore(self):
+        path = self.root / ".dockerignore"
+        self.current = path
+        if not path.is_file():
+            self.fail(path, "missing: `COPY` would send local state and tokens into the build")
+            return
+        self.files += 1
+        patterns = [l.strip() for l in path.read_text(encoding="utf-8").splitlines()
+                    if l.strip() and not l.strip().startswith("#") and not l.strip().startswith("!")]
+        for sample in ("vrl-state", "client/vrl-state", "deploy/token", "vrl.token", "build", ".git"):
+            if not any(ignores(p, sample) for p in patterns):
+                self.fail(path, f"does not exclude {sample!r}")
+
+
+DEBIAN_12 = r"^((docker\.io/)?(library/)?|localhost/)debian:12([.\-@]|$)"
+
+
+def dockerfile_stages(text):
+    """Stages of a Dockerfile: [{"from", "base", "name", "instructions": [(KIND, args)]}].
+
+    Continuation lines are joined; ARGs declared before the first FROM are
+    substituted into FROM lines with their defaults.
+    """
+    lines, buf = [], ""
+    for raw in text.splitlines():
+        s = raw.strip()
+        if not buf and (not s or s.startswith("#")):
+            continue
+        if buf and s.startswith("#"):
+            continue
+        if s.endswith("\\"):
+            buf += s[:-1] + " "
+            continue
+        lines.append(buf + s)
+        buf = ""
+    if buf:
+        lines.append(buf)
+    global_args, stages = {}, []
+    for line in lines:
+        kind, _, args = line.partition(" ")
+        kind = kind.upper()
+        if kind == "ARG" and not stages:
+            name, _, default = args.strip().partition("=")
+            global_args[name] = default.strip().strip('"')
+        elif kind == "FROM":
+            words = [w for w in args.split() if not w.startswith("--")]
+            image = words[0] if words else ""
+            base = re.sub(r"\$\{?([A-Za-z_][A-Za-z0-9_]*)\}?", lambda m: global_args.get(m.group(1), ""), image)
+            name = words[2] if len(words) >= 3 and words[1].upper() == "AS" else None
+            stages.append({"from": image, "base": base, "name": name, "instructions": []})
+        elif stages:
+            stages[-1]["instructions"].append((kind, args.strip()))
+    return stages
+
+
+def compiled_subdirectories(cmake_text):
+    """add_subdirectory() names of a top-level CMakeLists.txt that a build with
+    VRL_BUILD_TESTS=OFF (and VRL_FUZZ_ONLY off) configures."""
+    subs, skipping = [], []
+    for raw in cmake_text.splitlines():
+        line = raw.split("#", 1)[0].strip()
+        m = re.match(r"if\s*\((.*)\)", line)
+        if m:
+            skipping.append(bool(re.search(r"\bVRL_(BUILD_TESTS|FUZZ_ONLY)\b", m.group(1))))
+            continue
+        if re.match(r"endif\s*\(", line):
+            if skipping:
+                skipping.pop()
+            continue
+        m = re.match(r"add_subdirectory\s*\(\s*([^\s)]+)", line)
+        if m and not any(skipping):
+            subs.append(m.group(1))
+    return subs
+
+
+def ignores(pattern, sample):
+    """Whether a .dockerignore pattern excludes the path `sample` (Go filepath.Match
+    with `**`, as Docker and buildah read it; a directory excludes its contents)."""
+    pattern = pattern.strip("/")
+    regex = ""
+    i = 0
+    while i < len(pattern):
+        if pattern.startswith("**/", i):
+            regex += "(.*/)?"
+            i += 3
+        elif pattern.startswith("**", i):
+            regex += ".*"
+            i += 2
+        elif pattern[i] == "*":
+            regex += "[^/]*"
+            i += 1
+        elif pattern[i] == "?":
+            regex += "[^/]"
+            i += 1
+        else:
+            regex += re.escape(pattern[i])
+            i += 1
+    return re.fullmatch(regex + "(/.*)?", sample) is not None
 
 
 def main(argv):
