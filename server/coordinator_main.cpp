@@ -17,6 +17,7 @@ namespace vrl::server {
 int coordinatorMain(int argc, char** argv) {
     CLI::App app{"vrl-coordinator: loads scenes, traces light paths, builds the VRL light tree once per job, and "
                  "leases image tiles to vrl-worker processes over gRPC"};
+    app.set_version_flag("--version", std::string("vrl-coordinator ") + VRL_VERSION + " (protocol vrl.v1)");
     ServerOptions server;
     CoordinatorOptions options;
     std::string tokenFile, portFile, logLevel = "info";

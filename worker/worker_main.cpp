@@ -15,6 +15,7 @@ namespace vrl::worker {
 
 int workerMain(int argc, char** argv) {
     CLI::App app{"vrl-worker: shades image tiles leased from a vrl-coordinator with the scalable VRL estimator"};
+    app.set_version_flag("--version", std::string("vrl-worker ") + VRL_VERSION + " (protocol vrl.v1)");
     WorkerOptions options;
     std::string tokenFile, logLevel = "info";
     app.add_option("--coordinator", options.coordinator, "coordinator address (host:port)")->capture_default_str();
