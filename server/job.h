@@ -26,6 +26,10 @@
 
 namespace vrl::server {
 
+// Progress phases whose times are also in RenderStatistics (tracingSeconds, treeSeconds).
+inline constexpr const char* kLightTracingPhase = "light tracing";
+inline constexpr const char* kLightTreePhase = "light tree";
+
 struct Job {
     std::string id;
     v1::JobSpec spec;

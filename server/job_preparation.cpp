@@ -41,8 +41,8 @@ PreparedJob JobPreparation::prepare(const Job& job, const ProgressCallback& prog
     t0 = Clock::now();
     const RenderLights lights = prepareLights(*scene.scene, scene.settings, progress, &statistics);
     if (statistics.vrlCount > 0) {
-        phases.emplace_back("light tracing", statistics.tracingSeconds);
-        if (statistics.treeSeconds > 0.0) phases.emplace_back("light tree", statistics.treeSeconds);
+        phases.emplace_back(kLightTracingPhase, statistics.tracingSeconds);
+        if (statistics.treeSeconds > 0.0) phases.emplace_back(kLightTreePhase, statistics.treeSeconds);
     }
     t0 = Clock::now();
     if (lights.tree.root() >= 0) {

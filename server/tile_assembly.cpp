@@ -121,7 +121,10 @@ std::optional<std::string> writeJobImage(Job& job) {
     record.sceneNotes = job.sceneNotes;
     record.settings = job.settings;
     record.statistics = stats;
-    for (const auto& [phase, seconds] : job.phases) record.phases.emplace_back(camelCase(phase), seconds);
+    // Light tracing and the tree build are in `stats` (vrl.time.lightTracing, vrl.time.treeBuild): the
+    // progress phases that repeat them are not written a second time under other names.
+    for (const auto& [phase, seconds] : job.phases)
+        if (phase != kLightTracingPhase && phase != kLightTreePhase) record.phases.emplace_back(camelCase(phase), seconds);
     record.run = {{"job", job.id}, {"workers", int32_t(job.workers.size())}};
     writeRenderMetadata(record, *job.camera, images.metadata);
     try {
