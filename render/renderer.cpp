@@ -268,6 +268,7 @@ ImageSet render(const Scene& scene, const RenderSettings& settings, const Progre
     std::atomic<int> tilesDone{0};
     std::vector<int> tileRows(tiles.size(), 0);  // rows shaded per tile
     const double totalPixels = double(width) * height;
+    if (progress) progress("rendering", 0.0);
     tbb::parallel_for(tbb::blocked_range<size_t>(0, tiles.size(), 1), [&](const tbb::blocked_range<size_t>& range) {
         for (size_t t = range.begin(); t < range.end(); ++t) {
             if (stopRequested()) return;
