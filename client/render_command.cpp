@@ -112,7 +112,6 @@ int runRender(const RenderCommandOptions& o, const CLI::App& command) {
     rpc::ResolvedJob job = rpc::resolveJob(o.scene, spec, limits);
     const SceneDescription& description = job.description;
     const RenderSettings& settings = job.settings;
-    const auto& sensor = description.sensor;
     const double parseSeconds = secondsSince(t0);
     warnIneffectiveFlags(command, settings.method, false);
     checkLightMemory(settings, util::physicalMemoryBytes());
@@ -194,7 +193,7 @@ int runRender(const RenderCommandOptions& o, const CLI::App& command) {
                  "  parse  %8.3f s\n  build  %8.3f s (%zu shapes, %zu media, %zu emitters)\n"
                  "  render %8.3f s (%llu camera samples, %.3g samples/s)\n  write  %8.3f s -> %s\n"
                  "  peak memory %.1f MiB\n",
-                 o.scene.c_str(), sensor.width, sensor.height, std::string(methodName(settings.method)).c_str(), settings.samplesPerPixel,
+                 o.scene.c_str(), scene->camera().width(), scene->camera().height(), std::string(methodName(settings.method)).c_str(), settings.samplesPerPixel,
                  (unsigned long long)settings.seed, threads, parseSeconds, buildSeconds, scene->shapes().size(),
                  scene->media().size(), scene->emitters().size(), stats.seconds,
                  (unsigned long long)stats.cameraSamples,

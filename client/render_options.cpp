@@ -35,6 +35,8 @@ void addRenderOptions(CLI::App& cmd, RenderCommandOptions& o) {
     cmd.add_option("--spp", o.spp, "Samples per pixel (default: the scene's sampler sampleCount)")
         ->check(CLI::Range(1, kMaxSampleCount));
     cmd.add_option("--resolution", o.resolution, "Image size WxH, overriding the scene's film (e.g. 640x480)");
+    cmd.add_option("--crop", o.crop, "Render only the window x,y,width,height of the film (after --resolution), "
+                   "overriding the scene's crop; its pixels equal the full render's (e.g. 16,8,32,24)");
     cmd.add_option("--threads", o.threads,
                    "Shading threads; 0 (the default) = all cores (with --workers: per worker, default cores / N)")
         ->check(CLI::Range(0, 4096));
@@ -173,6 +175,14 @@ v1::RenderParameters toRenderParameters(const RenderCommandOptions& o) {
                                         std::to_string(kMaxFilmPixels) + " pixels)");
         p.set_width(uint32_t(w));
         p.set_height(uint32_t(h));
+    }
+    if (!o.crop.empty()) {  // checked against the film by rpc::resolveJob
+        std::smatch m;
+        if (!std::regex_match(o.crop, m, std::regex("^([0-9]{1,9}),([0-9]{1,9}),([0-9]{1,9}),([0-9]{1,9})$")))
+            throw std::invalid_argument("--crop expects x,y,width,height in film pixels (e.g. 16,8,32,24), got '" +
+                                        o.crop + "'");
+        auto& c = *p.mutable_crop();
+        c.set_x(std::stoul(m[1])), c.set_y(std::stoul(m[2])), c.set_width(std::stoul(m[3])), c.set_height(std::stoul(m[4]));
     }
     p.set_transport(o.transport);
     p.set_vrl_count(o.vrls);

@@ -23,6 +23,7 @@ struct RenderCommandOptions {
     std::string method;  // empty: the scene's <integrator> if it names one of ours, else the headline method
     int spp = 0;  // 0: the scene's sampleCount
     std::string resolution;  // "WxH", empty: the scene's film
+    std::string crop;        // "x,y,w,h" of the (resolved) film, empty: the scene's crop window if any
     int threads = 0;         // 0: all cores
     uint64_t seed = 0;
     int maxDepth = -2;  // -2: the scene's integrator maxDepth

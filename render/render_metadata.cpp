@@ -18,6 +18,10 @@ void writeRenderMetadata(const RenderRecord& record, const PerspectiveCamera& ca
     metadata["vrl.jitter"] = int32_t(s.jitter ? 1 : 0);
     metadata["vrl.width"] = int32_t(camera.width());
     metadata["vrl.height"] = int32_t(camera.height());
+    if (camera.crop()) {
+        metadata["vrl.crop"] = camera.crop()->toString();
+        metadata["vrl.film"] = std::to_string(camera.filmWidth()) + "x" + std::to_string(camera.filmHeight());
+    }
     std::string defines;
     for (const auto& [name, value] : record.defines) defines += (defines.empty() ? "" : " ") + name + "=" + value;
     metadata["vrl.defines"] = defines;

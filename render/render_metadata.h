@@ -9,7 +9,8 @@
 //   vrl.version, vrl.scene, vrl.method, vrl.defines ("a=1 b=2", sorted), vrl.medium,
 //   vrl.approximations, vrl.ignored                                   string
 //   vrl.seed                                        string (a 64-bit value: no EXR int holds it)
-//   vrl.spp, vrl.maxDepth, vrl.jitter (0/1), vrl.width, vrl.height    int
+//   vrl.spp, vrl.maxDepth, vrl.jitter (0/1), vrl.width, vrl.height    int (the image: the crop's size)
+//   cropped renders only: vrl.crop ("x0,y0,width,height" in film pixels), vrl.film ("WxH")  string
 //   methods with virtual lights: vrl.transport (string), vrl.vrlSamples (int),
 //     vrl.vrls or vrl.vpls, vrl.lightPaths (double: counts beyond 2^31)
 //   Lightcuts: vrl.error, vrl.hgEpsilon (float); vrl.maxCut, vrl.exactDistanceBelow,
@@ -18,7 +19,8 @@
 //   VPL methods: vrl.vplDistanceSamples (int)
 //   vrl.time.<phase> (double seconds): lightTracing, treeBuild, render, and the caller's phases
 //   vrl.run.<name>: the caller's (threads, workers, job)
-//   worldToCamera, worldToNDC (M44f): OpenEXR's standard camera attributes (camera.h)
+//   worldToCamera, worldToNDC (M44f): OpenEXR's standard camera attributes (camera.h);
+//     worldToNDC spans the image written (the crop window when cropped)
 #pragma once
 
 #include "render/image/metadata.h"

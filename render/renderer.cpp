@@ -19,10 +19,11 @@ namespace {
 
 constexpr const char* kCutLayerNames[3] = {"eval", "inter", "cut"};
 
+// The ray of image pixel (x, y): through its film pixel, so a crop shades what the full film would.
 Ray cameraRay(const PerspectiveCamera& camera, const RenderSettings& settings, int x, int y, Rng& rng) {
     const float jx = settings.jitter ? rng.next() : 0.5f;
     const float jy = settings.jitter ? rng.next() : 0.5f;
-    return camera.generateRay(float(x) + jx, float(y) + jy);
+    return camera.generateRay(float(x + camera.cropX0()) + jx, float(y + camera.cropY0()) + jy);
 }
 
 bool isVrlMethod(const RenderSettings& settings) { return usesVirtualLights(settings.method); }
@@ -170,8 +171,7 @@ TileShader::~TileShader() = default;
 
 TileImages TileShader::renderTile(const TileRect& tile, const RenderStop& stop) const {
     const PerspectiveCamera& camera = scene_.camera();
-    const int width = camera.width();
-    if (tile.x0 < 0 || tile.y0 < 0 || tile.x1 > width || tile.y1 > camera.height() || tile.x0 >= tile.x1 ||
+    if (tile.x0 < 0 || tile.y0 < 0 || tile.x1 > camera.width() || tile.y1 > camera.height() || tile.x0 >= tile.x1 ||
         tile.y0 >= tile.y1)
         throw std::invalid_argument("tile outside the image");
     const int w = tile.width(), h = tile.height();
@@ -185,7 +185,7 @@ TileImages TileShader::renderTile(const TileRect& tile, const RenderStop& stop) 
             return out;
         }
         for (int x = tile.x0; x < tile.x1; ++x) {
-            Rng rng(settings_.seed, uint64_t(y) * uint64_t(width) + uint64_t(x));
+            Rng rng(settings_.seed, camera.filmPixelIndex(x, y));
             const int tx = x - tile.x0, ty = y - tile.y0;
             if (tracer_) {
                 Rgb sum(0.0f);

@@ -1,7 +1,8 @@
 // Renderer: turns a Scene into an image with a chosen method, in parallel tiles
-// (TBB). Every pixel's random stream is seeded from (seed, pixel index), so the
-// image is bit-identical whatever the thread count, tile order or process that
-// shades a tile. The phases are public so that the service can split them: the
+// (TBB). Every pixel's random stream is seeded from (seed, film pixel index)
+// and its camera samples draw from it in order, so the image is bit-identical
+// whatever the thread count, tile size or order, or process that shades a tile,
+// and a crop window (camera.h) equals that window of the full film. The phases are public so that the service can split them: the
 // coordinator runs prepareLights once, workers run TileShader on leased tiles.
 #pragma once
 
@@ -38,8 +39,8 @@ enum class RenderMethod { Path, Vrl, VrlLightcuts, Vpl, VplLightcuts };
 inline constexpr std::array<RenderMethod, 5> kRenderMethods = {RenderMethod::Path, RenderMethod::Vrl,
                                                                RenderMethod::VrlLightcuts, RenderMethod::Vpl,
                                                                RenderMethod::VplLightcuts};
-
-// The method the README recommends, used when a job names none.
+// The method a job renders when neither it nor its scene's <integrator> names
+// one: the README's recommended method (the paper's, VRL Lightcuts).
 inline constexpr RenderMethod kHeadlineMethod = RenderMethod::VrlLightcuts;
 
 // "path", "vrl", "vrl-lightcuts", "vpl", "vpl-lightcuts".
@@ -146,8 +147,9 @@ struct TileImages {
 // "eval", "inter", "cut"); throws like validateRenderSettings.
 std::vector<std::string> renderLayerNames(const RenderSettings& settings);
 
-// Shades tiles (the worker's part). Pixel (x, y) uses the stream (seed, y * width
-// + x) only, so a tile's pixels equal those of a whole-image render bit for bit.
+// Shades tiles (the worker's part), in image pixels (the crop window's, if
+// any). Pixel (x, y) uses the stream (seed, camera.filmPixelIndex(x, y)) only,
+// so a tile's pixels equal those of a whole-image (and whole-film) render bit for bit.
 // renderTile is const and thread-safe; `lights` must outlive the TileShader.
 class TileShader {
 public:

@@ -11,6 +11,7 @@ PerspectiveCamera::PerspectiveCamera(const SensorDescription& sensor)
       position_(sensor.toWorld.applyPoint(Vec3(0.0f))),
       width_(sensor.width),
       height_(sensor.height),
+      crop_(sensor.crop ? checkFilmCrop(*sensor.crop, sensor.width, sensor.height) : std::nullopt),
       nearClip_(sensor.nearClip),
       farClip_(sensor.farClip) {
     const float w = float(width_), h = float(height_);
@@ -56,6 +57,15 @@ Imath::M44f PerspectiveCamera::worldToNDC() const {
     projection[2][1] = 0.5f;
     projection[2][2] = 1.0f;
     projection[2][3] = 1.0f;
+    if (crop_) {
+        // Film NDC to the crop window's: x' = (x W - x0) / w, y' likewise (the offset times w, as x and y are).
+        Imath::M44f toWindow;  // identity
+        toWindow[0][0] = float(width_) / float(crop_->width);
+        toWindow[3][0] = -float(crop_->x0) / float(crop_->width);
+        toWindow[1][1] = float(height_) / float(crop_->height);
+        toWindow[3][1] = -float(crop_->y0) / float(crop_->height);
+        projection = projection * toWindow;
+    }
     return worldToCamera() * projection;
 }
 

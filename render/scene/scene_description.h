@@ -8,6 +8,7 @@
 #include "render/core/geometry.h"
 #include "render/core/rgb.h"
 #include "render/core/transform.h"
+#include "render/scene/film_crop.h"
 #include "render/scene/scene_error.h"
 
 #include <filesystem>
@@ -131,6 +132,9 @@ struct SensorDescription {
     float farClip = 1e4f;
     int width = 768;   // film
     int height = 576;  // film
+    // The window of the film that is rendered (checkFilmCrop: inside the film,
+    // never the whole film); absent: the whole film.
+    std::optional<FilmCrop> crop;
     int sampleCount = 4;  // sampler
     int medium = -1;      // medium containing the camera
     SourceLocation where;

@@ -9,12 +9,52 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
 #include <string>
 
 namespace vrl::rpc {
 
 namespace {
 constexpr int kMaxDepth = 100000;  // as `vrl render --max-depth`
+
+// A method with virtual lights needs some for its multiple scattering.
+void checkLightCount(RenderMethod method, const v1::RenderParameters& p) {
+    if (usesVirtualLights(method) && TransportSelection::parse(p.transport()).has(TransportPart::Multiple) &&
+        p.vrl_count() == 0 && p.light_paths() == 0)
+        throw JobSpecError("method " + std::string(methodName(method)) +
+                           " needs a VRL count or a number of light paths (both are 0)");
+}
+
+// The spec's method; if it names none, the scene's <integrator> when that names
+// one of ours (renderMethodNames, exactly), else kHeadlineMethod.
+RenderMethod jobMethod(const v1::RenderParameters& p, const IntegratorDescription& integrator) {
+    if (!p.method().empty()) return parseRenderMethod(p.method());
+    for (const RenderMethod method : kRenderMethods)
+        if (integrator.type == methodName(method)) return method;
+    return kHeadlineMethod;
+}
+
+// The spec's crop window (of the film as resolved), or the scene's checked
+// against that film; JobSpecError naming the window and the film if it does not fit.
+std::optional<FilmCrop> jobCrop(const v1::RenderParameters& p, const SensorDescription& sensor) {
+    const auto clamp = [](uint32_t v) { return int(std::min<uint32_t>(v, 1u << 30)); };
+    if (p.has_crop()) {
+        const auto& c = p.crop();
+        try {
+            return checkFilmCrop({clamp(c.x()), clamp(c.y()), clamp(c.width()), clamp(c.height())}, sensor.width,
+                                 sensor.height);
+        } catch (const std::invalid_argument& e) {
+            throw JobSpecError(std::string("crop: ") + e.what());
+        }
+    }
+    if (!sensor.crop) return std::nullopt;
+    try {
+        return checkFilmCrop(*sensor.crop, sensor.width, sensor.height);
+    } catch (const std::invalid_argument& e) {
+        throw JobSpecError(std::string("the scene's film crop does not suit the resolution asked for: ") + e.what() +
+                           "; give a crop window for this resolution (vrl render --crop x,y,width,height)");
+    }
+}
 }  // namespace
 
 int jobTileSize(const v1::JobSpec& spec) { return spec.tile_size() == 0 ? 32 : int(spec.tile_size()); }
@@ -47,9 +87,9 @@ void validateJobSpec(const v1::JobSpec& spec, const ServiceLimits& limits) {
                            std::to_string(kMaxSpecBytes));
     if (!spec.has_parameters()) throw JobSpecError("the job has no parameters (method, samples, resolution, ...)");
     const auto& p = spec.parameters();
-    RenderMethod method;
+    std::optional<RenderMethod> method;  // empty: the scene's, known once it is parsed (resolveJob)
     try {
-        method = p.method().empty() ? kHeadlineMethod : parseRenderMethod(p.method());
+        if (!p.method().empty()) method = parseRenderMethod(p.method());
     } catch (const std::invalid_argument& e) {
         throw JobSpecError(e.what());
     }
@@ -115,9 +155,7 @@ void validateJobSpec(const v1::JobSpec& spec, const ServiceLimits& limits) {
     } catch (const std::exception& e) {
         throw JobSpecError(e.what());
     }
-    if (usesVirtualLights(method) && transports.has(TransportPart::Multiple) && p.vrl_count() == 0 &&
-        p.light_paths() == 0)
-        throw JobSpecError("method " + p.method() + " needs a VRL count or a number of light paths (both are 0)");
+    if (method) checkLightCount(*method, p);
 }
 
 ResolvedJob resolveJob(const std::filesystem::path& sceneFile, const v1::JobSpec& spec, const ServiceLimits& limits,
@@ -135,6 +173,7 @@ ResolvedJob resolveJob(const std::filesystem::path& sceneFile, const v1::JobSpec
         description.sensor.width = int(std::min<uint32_t>(p.width(), 1u << 30));
         description.sensor.height = int(std::min<uint32_t>(p.height(), 1u << 30));
     }
+    description.sensor.crop = jobCrop(p, description.sensor);  // relative to the film just resolved
     const auto& sensor = description.sensor;
     const uint64_t pixels = uint64_t(sensor.width) * uint64_t(sensor.height);
     if (sensor.width < 1 || sensor.height < 1 || sensor.width > kMaxFilmSide || sensor.height > kMaxFilmSide ||
@@ -143,7 +182,8 @@ ResolvedJob resolveJob(const std::filesystem::path& sceneFile, const v1::JobSpec
                            " is outside the supported range (1.." + std::to_string(kMaxFilmSide) +
                            " per side, at most " + std::to_string(limits.maxPixels) + " pixels)");
     RenderSettings& s = job.settings;
-    s.method = p.method().empty() ? kHeadlineMethod : parseRenderMethod(p.method());
+    s.method = jobMethod(p, description.integrator);
+    checkLightCount(s.method, p);
     s.samplesPerPixel = p.samples_per_pixel() > 0 ? p.samples_per_pixel() : sensor.sampleCount;
     s.seed = p.seed();
     s.jitter = p.jitter();
@@ -167,9 +207,9 @@ JobScene loadJobScene(const std::filesystem::path& bundleDirectory, const std::f
     ResolvedJob resolved = resolveJob(sceneFile, spec, limits, bundleDirectory);
     JobScene job;
     job.settings = resolved.settings;
-    job.width = resolved.description.sensor.width;
-    job.height = resolved.description.sensor.height;
     job.scene = Scene::build(resolved.description);
+    job.width = job.scene->camera().width();  // the image: the crop window if there is one
+    job.height = job.scene->camera().height();
     return job;
 }
 

@@ -27,23 +27,26 @@ struct JobSpecError : std::invalid_argument {
 
 // A job resolved against its scene file, before the scene is built.
 struct ResolvedJob {
-    SceneDescription description;  // parsed, defines applied, --medium filled, resolution overridden
+    SceneDescription description;  // parsed, defines applied, --medium filled, resolution and crop overridden
     RenderSettings settings;
 };
 
 struct JobScene {
     std::unique_ptr<Scene> scene;
     RenderSettings settings;
-    int width = 0, height = 0;
+    int width = 0, height = 0;  // the image: the crop window's size if there is one
 };
 
 // Checks parameters that need no scene (method, counts, tile size) against the limits.
 void validateJobSpec(const v1::JobSpec& spec, const ServiceLimits& limits);
 
 // Validates the spec, parses `sceneFile` (confined to `confineTo` unless it is
-// empty), applies the spec's defines, fill medium and resolution, checks the
-// limits and resolves the RenderSettings (the scene's spp and depth where the
-// spec leaves them). Throws JobSpecError, SceneError or std::runtime_error.
+// empty), applies the spec's defines, fill medium, resolution and then crop
+// window (relative to the resolved film; absent: the scene's, which must fit
+// it), checks the limits and resolves the RenderSettings (the scene's spp and
+// depth where the spec leaves them; with no method, the one the scene's
+// <integrator type> names if it is one of renderMethodNames(), else
+// kHeadlineMethod). Throws JobSpecError, SceneError or std::runtime_error.
 ResolvedJob resolveJob(const std::filesystem::path& sceneFile, const v1::JobSpec& spec, const ServiceLimits& limits,
                        const std::filesystem::path& confineTo = {});
 

@@ -8,6 +8,7 @@
 #include <cmath>
 #include <memory>
 #include <numbers>
+#include <set>
 
 #include "render/scene_io/mitsuba/mitsuba_bsdf_parser.h"
 #include "render/scene_io/mitsuba/mitsuba_parse_context.h"
@@ -32,18 +33,21 @@ using xml::PluginParams;
 using T = xml::ParamType;
 using U = xml::ParamUse;
 // clang-format off
-// Integrators this renderer implements (the rendering method still comes from
-// --method), then the other Mitsuba 0.5/0.6 integrators: accepted, their
-// parameters listed in SceneDescription::ignored, only maxDepth read.
+// Integrators this renderer implements: the path tracer's Mitsuba names and
+// the rendering methods' own names (renderer.h: path, vrl, vrl-lightcuts, vpl,
+// vpl-lightcuts; a job with no method renders the one its scene names), then the
+// other Mitsuba 0.5/0.6 integrators: accepted, their parameters listed in
+// SceneDescription::ignored, only maxDepth read.
 constexpr std::string_view kIntegratorTypes[] = {
-    "volpath", "volpath_simple", "path", "direct", "vrl", "vrlcuts",
-    "ao", "bdpt", "photonmapper", "ppm", "sppm", "pssmlt", "mlt", "erpt", "ptracer", "vpl",
+    "volpath", "volpath_simple", "path", "direct", "vrl", "vrlcuts", "vrl-lightcuts", "vpl", "vpl-lightcuts",
+    "ao", "bdpt", "photonmapper", "ppm", "sppm", "pssmlt", "mlt", "erpt", "ptracer",
     "adaptive", "irrcache", "multichannel", "field"};
-constexpr size_t kOwnIntegratorCount = 6;
+constexpr size_t kOwnIntegratorCount = 9;
 constexpr ParamSpec kIntegratorParameters[] = {
     {"maxDepth", T::Integer}, {"rrDepth", T::Integer, U::Ignore},
     {"strictNormals", T::Boolean, U::Ignore}, {"hideEmitters", T::Boolean, U::Ignore},
-    {"version", T::Integer, U::Ignore}};  // lajolla's integrator version tag
+    {"version", T::Integer, U::Ignore},  // lajolla's integrator version tag
+    {"shadowMapResolution", T::Integer, U::Ignore}, {"clamping", T::Float, U::Ignore}};  // Mitsuba's vpl
 
 constexpr std::string_view kSensorTypes[] = {"perspective"};
 constexpr ParamSpec kPerspectiveParameters[] = {
@@ -59,8 +63,7 @@ constexpr ParamSpec kFilmParameters[] = {
     {"highQualityEdges", T::Boolean, U::Ignore}, {"attachLog", T::Boolean, U::Ignore},
     {"gamma", T::Float, U::Ignore}, {"exposure", T::Float, U::Ignore}, {"tonemapMethod", T::String, U::Ignore},
     {"key", T::Float, U::Ignore}, {"burn", T::Float, U::Ignore},
-    {"cropOffsetX", T::Integer, U::Unsupported}, {"cropOffsetY", T::Integer, U::Unsupported},
-    {"cropWidth", T::Integer, U::Unsupported}, {"cropHeight", T::Integer, U::Unsupported}};
+    {"cropOffsetX", T::Integer}, {"cropOffsetY", T::Integer}, {"cropWidth", T::Integer}, {"cropHeight", T::Integer}};
 constexpr std::string_view kRfilterTypes[] = {"box", "tent", "gaussian", "mitchell", "catmullrom", "lanczos"};
 constexpr ParamSpec kRfilterParameters[] = {
     {"radius", T::Float, U::Ignore}, {"stddev", T::Float, U::Ignore}, {"B", T::Float, U::Ignore},
@@ -120,7 +123,9 @@ void checkMaxDepth(const Element& at, int maxDepth) {
 class SceneParser {
 public:
     explicit SceneParser(const ParseOptions& options)
-        : defines_(options.defines.begin(), options.defines.end()), context_(options) {}
+        : defines_(options.defines.begin(), options.defines.end()),
+          commandLineDefines_(options.defines),
+          context_(options) {}
 
     SceneDescription parse(std::unique_ptr<xml::XmlFile> file, const std::filesystem::path& identity,
                            std::optional<std::filesystem::path> canonicalPath);
@@ -148,8 +153,14 @@ private:
     }
     int referencedMedium(const Element& ref);
     int mediumChild(const Element& child, int current);  // nested <medium> or <ref> to one
+    // Keeps a loaded file alive and notes the $names it mentions.
+    const xml::XmlFile& addFile(std::unique_ptr<xml::XmlFile> file);
+    // Fails on a -D define that no <default> declares and no $name uses.
+    void checkDefinesUsed() const;
 
     xml::Defines defines_;
+    std::map<std::string, std::string> commandLineDefines_;
+    std::set<std::string> defaultNames_, references_;  // <default name=...> and every $identifier, in all files
     mitsuba::ParseContext context_;
     SceneDescription& scene_ = context_.scene();
     std::vector<std::unique_ptr<xml::XmlFile>> files_;  // alive while their elements are in use
@@ -159,8 +170,8 @@ private:
 
 SceneDescription SceneParser::parse(std::unique_ptr<xml::XmlFile> file, const std::filesystem::path& identity,
                                     std::optional<std::filesystem::path> canonicalPath) {
-    const Element root(*file, file->root(), defines_);
-    files_.push_back(std::move(file));
+    const xml::XmlFile& sceneFile = addFile(std::move(file));
+    const Element root(sceneFile, sceneFile.root(), defines_);
     if (root.tag() != "scene") root.fail("the root element must be <scene>, not <" + root.tag() + ">");
     root.checkAttributes({"version"});
     scene_.version = root.requireAttribute("version");
@@ -175,11 +186,37 @@ SceneDescription SceneParser::parse(std::unique_ptr<xml::XmlFile> file, const st
     if (canonicalPath) includeStack_.push_back(*canonicalPath);
 
     parseSceneChildren(root);
+    checkDefinesUsed();
 
     if (!sensorAt_) spdlog::warn("{}: the scene has no <sensor>; using the default camera", identity.string());
     if (!integratorAt_)
         spdlog::debug("{}: the scene has no <integrator>; using {}", identity.string(), scene_.integrator.type);
     return context_.finish();
+}
+
+const xml::XmlFile& SceneParser::addFile(std::unique_ptr<xml::XmlFile> file) {
+    references_.merge(xml::parameterReferences(*file));
+    files_.push_back(std::move(file));
+    return *files_.back();
+}
+
+void SceneParser::checkDefinesUsed() const {
+    std::set<std::string> used = defaultNames_;
+    for (const std::string& identifier : references_)
+        if (const auto name = xml::resolveParameter(identifier, defines_)) used.insert(*name);
+    std::string problems;
+    for (const auto& [name, value] : commandLineDefines_) {
+        if (used.contains(name)) continue;
+        problems += (problems.empty() ? "" : "; ") +
+                    fmt::format("-D {}={}: the scene uses no ${} and has no <default name=\"{}\">", util::abbreviate(name),
+                                util::abbreviate(value), util::abbreviate(name), util::abbreviate(name));
+    }
+    if (problems.empty()) return;
+    std::set<std::string> names = defaultNames_;
+    names.insert(references_.begin(), references_.end());
+    const std::vector<std::string> list(names.begin(), names.end());
+    throw SceneError({scene_.file.string(), 0, ""},
+                     problems + (list.empty() ? "; it uses no $names" : "; names it uses: " + xml::joinNames(list)));
 }
 
 void SceneParser::parseSceneChildren(const Element& scene) {
@@ -219,6 +256,7 @@ void SceneParser::parseDefault(const Element& element) {
     });
     if (!identifier) element.fail("invalid parameter name '" + name + "' (use letters, digits and '_')");
     const std::string value = element.requireAttribute("value");
+    defaultNames_.insert(name);
     defines_.try_emplace(name, value);  // a -D define or an earlier <default> wins
 }
 
@@ -226,7 +264,7 @@ void SceneParser::parseInclude(const Element& element) {
     element.checkAttributes({"filename"});
     const std::filesystem::path path = element.resolvePath(element.requireAttribute("filename"));
     context_.checkReference(element, path);
-    const std::string text = xml::readTextFile(path, element.where(), "included file");
+    const std::string text = xml::readTextFile(path, element.where(), "included file", kMaxSceneFileBytes);
     std::error_code error;
     const std::filesystem::path canonical = std::filesystem::weakly_canonical(path, error);
     if (std::find(includeStack_.begin(), includeStack_.end(), canonical) != includeStack_.end())
@@ -234,8 +272,8 @@ void SceneParser::parseInclude(const Element& element) {
     if (static_cast<int>(includeStack_.size()) >= kMaxIncludeDepth)
         element.fail("includes are nested more than " + std::to_string(kMaxIncludeDepth) + " deep");
 
-    files_.push_back(std::make_unique<xml::XmlFile>(text, path.string(), path.parent_path()));
-    const Element root(*files_.back(), files_.back()->root(), defines_);
+    const xml::XmlFile& included = addFile(std::make_unique<xml::XmlFile>(text, path.string(), path.parent_path()));
+    const Element root(included, included.root(), defines_);
     if (root.tag() != "scene") root.fail("an included file's root element must be <scene>, not <" + root.tag() + ">");
     root.checkAttributes({"version"});
     includeStack_.push_back(canonical);
@@ -396,6 +434,18 @@ void SceneParser::parseFilm(const Element& element, SensorDescription& sensor) {
     if (static_cast<long long>(sensor.width) * sensor.height > kMaxFilmPixels)
         element.fail(fmt::format("the film has {} x {} pixels, more than the limit of {}", sensor.width, sensor.height,
                                  kMaxFilmPixels));
+    // Mitsuba's crop window: offsets default to 0, the size to the film's.
+    if (params.has("cropOffsetX") || params.has("cropOffsetY") || params.has("cropWidth") || params.has("cropHeight")) {
+        const FilmCrop crop{params.getInteger("cropOffsetX").value_or(0), params.getInteger("cropOffsetY").value_or(0),
+                            params.getInteger("cropWidth").value_or(sensor.width),
+                            params.getInteger("cropHeight").value_or(sensor.height)};
+        try {
+            sensor.crop = checkFilmCrop(crop, sensor.width, sensor.height);
+        } catch (const std::invalid_argument& e) {
+            element.fail(fmt::format("cropOffsetX {}, cropOffsetY {}, cropWidth {}, cropHeight {}: {}", crop.x0,
+                                     crop.y0, crop.width, crop.height, e.what()));
+        }
+    }
 }
 
 void SceneParser::parseSampler(const Element& element, SensorDescription& sensor) {
@@ -616,7 +666,7 @@ int SceneParser::referencedMedium(const Element& ref) {
 
 SceneDescription parseMitsubaScene(const std::filesystem::path& file, const ParseOptions& options) {
     if (options.onFileReferenced) options.onFileReferenced(file);
-    const std::string text = xml::readTextFile(file, {file.string(), 0, ""}, "scene file");
+    const std::string text = xml::readTextFile(file, {file.string(), 0, ""}, "scene file", kMaxSceneFileBytes);
     auto xmlFile = std::make_unique<xml::XmlFile>(text, file.string(), file.parent_path());
     std::error_code error;
     return SceneParser(options).parse(std::move(xmlFile), file, std::filesystem::weakly_canonical(file, error));

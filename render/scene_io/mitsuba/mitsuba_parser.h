@@ -9,7 +9,9 @@
 //
 // Supported subset (everything else is a SceneError that names the file, the
 // 1-based line and the element, and where useful lists the valid names):
-//   <scene version="0.x.y">, <default name value>, $name in any attribute,
+//   <scene version="0.x.y">, <default name value>, $name in any attribute
+//   (a -D define the scene never uses is an error), files of at most
+//   kMaxSceneFileBytes,
 //   <include filename>, id/<ref id> (ids are global wherever they are nested;
 //   refs name bsdfs, media and textures declared earlier);
 //   values float, integer, boolean, string, rgb ("r, g, b" | "r g b" | "v" |
@@ -43,6 +45,7 @@
 // (a bump map's texture is checked but not stored).
 #pragma once
 
+#include <cstdint>
 #include <filesystem>
 #include <functional>
 #include <map>
@@ -53,9 +56,16 @@
 
 namespace vrl {
 
+// Largest scene or included XML file the parser reads (checked before reading;
+// real scenes are a few MiB at most, their geometry lives in mesh files).
+inline constexpr std::uintmax_t kMaxSceneFileBytes = std::uintmax_t(64) << 20;
+
 struct ParseOptions {
     // -D name=value: defines $name, overriding the scene's <default name=...>.
-    // A name with no <default> in the scene is still usable.
+    // A name with no <default> in the scene is still usable, but a name the
+    // scene (with its includes) neither declares with <default> nor mentions
+    // as $name anywhere is a SceneError listing the names it does use: a
+    // misspelled -D must not render the scene unchanged.
     std::map<std::string, std::string> defines;
     // If set, every file the scene references (includes, meshes) must lie
     // inside this directory once symbolic links are resolved; a reference

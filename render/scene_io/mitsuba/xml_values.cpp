@@ -182,10 +182,16 @@ int XmlFile::lineAtOffset(std::ptrdiff_t offset) const {
 
 int XmlFile::lineOf(pugi::xml_node node) const { return lineAtOffset(node.offset_debug()); }
 
-std::string readTextFile(const std::filesystem::path& path, const SourceLocation& where, const std::string& what) {
+std::string readTextFile(const std::filesystem::path& path, const SourceLocation& where, const std::string& what,
+                         std::uintmax_t maxBytes) {
     std::error_code error;
     if (!std::filesystem::is_regular_file(path, error))
         throw SceneError(where, "cannot find the " + what + " '" + path.string() + "'");
+    const std::uintmax_t size = std::filesystem::file_size(path, error);
+    if (!error && size > maxBytes)
+        throw SceneError(where, "the " + what + " '" + path.string() + "' is " + std::to_string(size) +
+                                    " bytes, over the limit of " + std::to_string(maxBytes) +
+                                    " bytes for a scene file; split it or move geometry into mesh files");
     std::ifstream in(path, std::ios::binary);
     std::string text(std::istreambuf_iterator<char>(in), {});
     if (!in && !in.eof()) throw SceneError(where, "cannot read the " + what + " '" + path.string() + "'");
@@ -205,18 +211,38 @@ Substitution substituteDefines(std::string_view text, const Defines& defines) {
         size_t end = i + 1;
         while (end < text.size() && isIdentifierChar(text[end])) ++end;
         const std::string_view identifier = text.substr(i + 1, end - i - 1);
-        bool found = false;
-        for (size_t length = identifier.size(); length > 0 && !found; --length) {
-            const auto it = defines.find(identifier.substr(0, length));
-            if (it != defines.end()) {
-                out += it->second;
-                i += 1 + length;
-                found = true;
-            }
-        }
-        if (!found) return {std::nullopt, std::string(identifier)};
+        const auto name = resolveParameter(identifier, defines);
+        if (!name) return {std::nullopt, std::string(identifier)};
+        out += defines.find(*name)->second;
+        i += 1 + name->size();
     }
     return {out, ""};
+}
+
+std::optional<std::string> resolveParameter(std::string_view identifier, const Defines& defines) {
+    for (size_t length = identifier.size(); length > 0; --length)
+        if (defines.contains(identifier.substr(0, length))) return std::string(identifier.substr(0, length));
+    return std::nullopt;
+}
+
+std::set<std::string> parameterReferences(const XmlFile& file) {
+    std::set<std::string> names;
+    std::vector<pugi::xml_node> stack{file.root()};
+    while (!stack.empty()) {
+        const pugi::xml_node node = stack.back();
+        stack.pop_back();
+        for (const pugi::xml_attribute a : node.attributes()) {
+            const std::string_view value = a.value();
+            for (size_t i = value.find('$'); i != std::string_view::npos; i = value.find('$', i + 1)) {
+                size_t end = i + 1;
+                while (end < value.size() && isIdentifierChar(value[end])) ++end;
+                if (end > i + 1) names.emplace(value.substr(i + 1, end - i - 1));
+            }
+        }
+        for (const pugi::xml_node child : node.children())
+            if (child.type() == pugi::node_element) stack.push_back(child);
+    }
+    return names;
 }
 
 // ---------------------------------------------------------------- Element

@@ -9,11 +9,13 @@
 #pragma once
 
 #include <filesystem>
+#include <cstdint>
 #include <functional>
 #include <initializer_list>
 #include <map>
 #include <optional>
 #include <pugixml.hpp>
+#include <set>
 #include <span>
 #include <string>
 #include <string_view>
@@ -55,9 +57,11 @@ private:
     pugi::xml_document document_;
 };
 
-// The contents of `path`; a missing or unreadable file is a SceneError at
-// `where` naming the path and `what` it was meant to be ("included file").
-std::string readTextFile(const std::filesystem::path& path, const SourceLocation& where, const std::string& what);
+// The contents of `path`; a missing or unreadable file, or one larger than
+// `maxBytes` (checked before reading), is a SceneError at `where` naming the
+// path and `what` it was meant to be ("included file").
+std::string readTextFile(const std::filesystem::path& path, const SourceLocation& where, const std::string& what,
+                         std::uintmax_t maxBytes);
 
 // `$name` definitions: -D overrides and <default> elements.
 using Defines = std::map<std::string, std::string, std::less<>>;
@@ -70,6 +74,14 @@ struct Substitution {
     std::string undefined;            // then the first undefined name ("" for a bare '$')
 };
 Substitution substituteDefines(std::string_view text, const Defines& defines);
+
+// The name a `$identifier` reference resolves to under that rule (the longest
+// defined prefix of `identifier`), or std::nullopt if none is defined.
+std::optional<std::string> resolveParameter(std::string_view identifier, const Defines& defines);
+
+// The identifiers after every '$' in `file`'s attribute values, read or not:
+// what its `$name` references may use (for reporting -D defines a scene never uses).
+std::set<std::string> parameterReferences(const XmlFile& file);
 
 // An element of an XmlFile. Attribute values come back with `$name`
 // substituted; errors name the file, line and element.

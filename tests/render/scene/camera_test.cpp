@@ -162,5 +162,27 @@ TEST(CameraTest, WorldToNdcMapsRayPointsToTheirFilmPosition) {
     }
 }
 
+// A crop window: the image is the window's size, pixels and random streams
+// keep their film indices, and worldToNDC spans the window (the EXR written).
+TEST(CameraTest, CropWindowKeepsFilmPixelsAndItsNdcSpansTheWindow) {
+    SensorDescription sensor = tiltedSensor(64, 48, 53.0f, FovAxis::X);
+    sensor.crop = FilmCrop{10, 6, 20, 12};
+    const PerspectiveCamera camera(sensor), full(tiltedSensor(64, 48, 53.0f, FovAxis::X));
+    EXPECT_EQ(camera.width(), 20);
+    EXPECT_EQ(camera.height(), 12);
+    EXPECT_EQ(camera.filmWidth(), 64);
+    EXPECT_EQ(camera.filmHeight(), 48);
+    EXPECT_EQ(camera.filmPixelIndex(0, 0), 6u * 64u + 10u);
+    EXPECT_EQ(camera.filmPixelIndex(19, 11), full.filmPixelIndex(29, 17));
+    const Imath::M44f toNdc = camera.worldToNDC();
+    for (const auto& [fx, fy] : {std::pair{10.0f, 6.0f}, std::pair{30.0f, 18.0f}, std::pair{17.5f, 9.25f}}) {
+        const Ray ray = camera.generateRay(fx, fy);
+        const Vec3 point = ray.origin + ray.direction * 5.0f;
+        const Imath::V4f ndc = Imath::V4f(point.x, point.y, point.z, 1.0f) * toNdc;
+        EXPECT_NEAR(ndc.x / ndc.w, (fx - 10.0f) / 20.0f, 1e-5f);
+        EXPECT_NEAR(ndc.y / ndc.w, (fy - 6.0f) / 12.0f, 1e-5f);
+    }
+}
+
 }  // namespace
 }  // namespace vrl

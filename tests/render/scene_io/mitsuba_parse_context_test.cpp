@@ -10,11 +10,23 @@
 
 #include <gtest/gtest.h>
 
+#include <filesystem>
+#include <fstream>
 #include <string>
 #include <vector>
 
 namespace vrl {
 namespace {
+
+// The message of the SceneError that parsing `file` throws; "" if none.
+std::string errorOfFile(const std::filesystem::path& file) {
+    try {
+        parseMitsubaScene(file);
+    } catch (const SceneError& e) {
+        return e.what();
+    }
+    return "";
+}
 
 using mitsuba_test::fixtureDir;
 using mitsuba_test::sceneXml;
@@ -108,10 +120,79 @@ TEST(MitsubaParserErrors, UndefinedParameterIsNamed) {
         {"bad.xml:3:", "$depth"}));
 }
 
-TEST(MitsubaParserErrors, DefineWithoutDefaultIsNotNeededWhenUnused) {
+// -D defines: a name is used if the scene (with its includes) declares it with
+// <default> or mentions $name anywhere, even in an attribute never read; any
+// other -D is an error listing the names the scene does use.
+TEST(MitsubaParserDefines, DefineUsedByADefaultOnly) {
     ParseOptions options;
+    options.defines = {{"spp", "3"}};
+    EXPECT_NO_THROW(parse({"<default name=\"spp\" value=\"4\"/>"}, options));
+}
+
+TEST(MitsubaParserDefines, DefineUsedByADollarNameOnly) {
+    ParseOptions options;
+    options.defines = {{"depth", "3"}};
+    EXPECT_EQ(parse({"<integrator type=\"path\"><integer name=\"maxDepth\" value=\"$depth\"/></integrator>"}, options)
+                  .integrator.maxDepth,
+              3);
+    // Mitsuba's longest-prefix rule: $res0 uses "res" when no "res0" is defined.
+    options.defines = {{"res", "7"}};
+    EXPECT_EQ(parse({"<integrator type=\"path\"><integer name=\"maxDepth\" value=\"$res0\"/></integrator>"}, options)
+                  .integrator.maxDepth,
+              70);
+}
+
+TEST(MitsubaParserDefines, DefineUsedInAnIncludedFile) {
+    const SceneFiles files({"stand-in.txt"});
+    {
+        std::ofstream out(files / "part.xml");
+        out << "<scene version=\"0.5.0\"><integrator type=\"path\"><integer name=\"maxDepth\" value=\"$depth\"/>"
+               "</integrator><default name=\"fromInclude\" value=\"1\"/></scene>\n";
+    }
+    ParseOptions options;
+    options.defines = {{"depth", "4"}, {"fromInclude", "2"}};
+    EXPECT_EQ(files.parse({"<include filename=\"part.xml\"/>"}, options).integrator.maxDepth, 4);
+}
+
+TEST(MitsubaParserDefines, UnusedDefineIsAnErrorListingTheUsedNames) {
+    ParseOptions options;
+    options.defines = {{"sigmaS", "2"}};
+    const std::string message = errorOf(sceneXml({"<default name=\"albedo\" value=\"0.5\"/>",
+                                                  "<default name=\"sigmaT\" value=\"1\"/>",
+                                                  "<medium type=\"homogeneous\" id=\"m\">",
+                                                  "  <rgb name=\"sigmaT\" value=\"$sigmaT\"/>",
+                                                  "  <rgb name=\"albedo\" value=\"$albedo\"/></medium>"}),
+                                        options);
+    EXPECT_TRUE(mentions(message, {"bad.xml: -D sigmaS=2: the scene uses no $sigmaS and has no <default "
+                                   "name=\"sigmaS\">; names it uses: albedo, sigmaT"}))
+        << message;
     options.defines = {{"unused", "1"}};
-    EXPECT_NO_THROW(parseMitsubaSceneString(sceneXml({}), fixtureDir(), options));
+    EXPECT_TRUE(mentions(errorOf(sceneXml({}), options), {"-D unused=1", "it uses no $names"}));
+}
+
+// A scene or included file over kMaxSceneFileBytes is refused before it is
+// read (the files here are sparse: no disk space is used).
+TEST(MitsubaParserErrors, SceneFilesOverTheSizeCapAreRefusedUnread) {
+    const SceneFiles files({"stand-in.txt"});
+    std::ofstream(files / "huge.xml") << "<scene version=\"0.5.0\"/>\n";
+    std::filesystem::resize_file(files / "huge.xml", kMaxSceneFileBytes + 1);
+    const std::string size = std::to_string(kMaxSceneFileBytes + 1), cap = std::to_string(kMaxSceneFileBytes);
+    try {
+        parseMitsubaScene(files / "huge.xml");
+        ADD_FAILURE() << "a scene file over the cap was read";
+    } catch (const SceneError& e) {
+        EXPECT_TRUE(mentions(e.what(), {"scene file", "huge.xml", size + " bytes", "limit of " + cap})) << e.what();
+    }
+    try {
+        files.parse({"<include filename=\"huge.xml\"/>"});
+        ADD_FAILURE() << "an included file over the cap was read";
+    } catch (const SceneError& e) {
+        EXPECT_TRUE(mentions(e.what(), {"test.xml:2", "included file", "huge.xml", size + " bytes", "limit of " + cap}))
+            << e.what();
+    }
+    // At the cap exactly, the file is read (and here fails as XML, not for its size).
+    std::filesystem::resize_file(files / "huge.xml", kMaxSceneFileBytes);
+    EXPECT_FALSE(mentions(errorOfFile(files / "huge.xml"), {"limit of"}));
 }
 
 TEST(MitsubaParserErrors, RootIsNotScene) {

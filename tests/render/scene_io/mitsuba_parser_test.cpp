@@ -45,9 +45,24 @@ TEST(MitsubaParser, EmptySceneKeepsDefaultsAndRecordsVersion) {
 }
 
 TEST(MitsubaParser, IntegratorTypesAreKeptAsWritten) {
-    for (const std::string type : {"volpath", "volpath_simple", "path", "direct", "vrl", "vrlcuts", "vpl"}) {
+    for (const std::string type : {"volpath", "volpath_simple", "path", "direct", "vrl", "vrlcuts", "vrl-lightcuts",
+                                   "vpl", "vpl-lightcuts"}) {
         const SceneDescription scene = parse({"<integrator type=\"" + type + "\"/>"});
         EXPECT_EQ(scene.integrator.type, type);
+    }
+}
+
+// An integrator named after one of our methods (renderer.h) is accepted with
+// its maxDepth, and neither ignored nor warned about: a job without a method renders it.
+TEST(MitsubaParser, IntegratorNamingOurMethodKeepsItsDepthWithoutWarning) {
+    for (const std::string type : {"path", "vrl", "vrl-lightcuts", "vpl", "vpl-lightcuts"}) {
+        LogCapture log;
+        const SceneDescription scene =
+            parse({"<integrator type=\"" + type + "\"><integer name=\"maxDepth\" value=\"5\"/></integrator>"});
+        EXPECT_EQ(scene.integrator.type, type);
+        EXPECT_EQ(scene.integrator.maxDepth, 5) << type;
+        EXPECT_TRUE(scene.ignored.empty()) << type;
+        EXPECT_EQ(log.text().find("integrator"), std::string::npos) << type << ": " << log.text();
     }
 }
 
@@ -72,6 +87,32 @@ TEST(MitsubaParser, IntegratorIgnoredParametersWarn) {
 }
 
 // ---------------------------------------------------------------- sensor, film, sampler
+
+// hdrfilm's crop window (Mitsuba: offsets default to 0, the size to the film's);
+// a window that is the whole film is no crop. Errors: mitsuba_error_cases_test.cpp.
+TEST(MitsubaParser, FilmCropWindow) {
+    const auto film = [](const std::string& crop) {
+        return parse({"<sensor type=\"perspective\"><film type=\"hdrfilm\">",
+                      "<integer name=\"width\" value=\"64\"/><integer name=\"height\" value=\"48\"/>", crop,
+                      "</film></sensor>"})
+            .sensor;
+    };
+    const SensorDescription all = film(
+        "<integer name=\"cropOffsetX\" value=\"8\"/><integer name=\"cropOffsetY\" value=\"4\"/>"
+        "<integer name=\"cropWidth\" value=\"16\"/><integer name=\"cropHeight\" value=\"12\"/>");
+    EXPECT_EQ(all.width, 64);
+    EXPECT_EQ(all.height, 48);
+    ASSERT_TRUE(all.crop);
+    EXPECT_EQ(*all.crop, (FilmCrop{8, 4, 16, 12}));
+    EXPECT_EQ(all.crop->toString(), "8,4,16,12");
+    const SensorDescription sizeOnly = film("<integer name=\"cropHeight\" value=\"10\"/>");
+    ASSERT_TRUE(sizeOnly.crop);
+    EXPECT_EQ(*sizeOnly.crop, (FilmCrop{0, 0, 64, 10}));
+    EXPECT_EQ(film("<integer name=\"cropOffsetX\" value=\"60\"/><integer name=\"cropWidth\" value=\"4\"/>").crop,
+              (FilmCrop{60, 0, 4, 48}));
+    EXPECT_FALSE(film("<integer name=\"cropWidth\" value=\"64\"/>").crop);  // the whole film
+    EXPECT_FALSE(film("").crop);
+}
 
 TEST(MitsubaParser, SensorFilmAndSampler) {
     const SceneDescription scene = parse({
@@ -410,13 +451,14 @@ TEST(MitsubaParserShape, SerializedMaxSmoothAngleIsReportedOnce) {
 
 TEST(MitsubaParserIntegrator, EveryMitsubaIntegratorIsAcceptedAndRecorded) {
     for (const std::string type : {"ao", "bdpt", "photonmapper", "ppm", "sppm", "pssmlt", "mlt", "erpt", "ptracer",
-                                   "vpl", "adaptive", "irrcache", "multichannel", "field"}) {
+                                   "adaptive", "irrcache", "multichannel", "field"}) {
         const SceneDescription scene = parse({"<integrator type=\"" + type + "\"/>"});
         EXPECT_EQ(scene.integrator.type, type);
         ASSERT_EQ(scene.ignored.size(), 1u) << type;
         EXPECT_TRUE(mentions(scene.ignored[0], {"integrator '" + type + "'", "--method"}));
     }
-    for (const std::string type : {"volpath", "volpath_simple", "path", "direct", "vrl", "vrlcuts"})
+    for (const std::string type : {"volpath", "volpath_simple", "path", "direct", "vrl", "vrlcuts", "vrl-lightcuts",
+                                   "vpl", "vpl-lightcuts"})
         EXPECT_TRUE(parse({"<integrator type=\"" + type + "\"/>"}).ignored.empty()) << type;
 }
 

@@ -1,0 +1,149 @@
+// Tests for the one builder of RenderSettings from a job spec
+// (service/job/job_scene.cpp: resolveJob): the method a spec leaves empty comes
+// from the scene's <integrator> when that names one of ours, else the headline
+// method; the crop window applies after the resolution and is checked against
+// the resolved film; a -D the scene does not use fails the job before rendering.
+#include "service/job/job_scene.h"
+
+#include "tests/support/temp_dir.h"
+
+#include <gtest/gtest.h>
+
+#include <fstream>
+#include <string>
+
+namespace vrl {
+namespace {
+
+// A tiny scene with `integrator` (e.g. "<integrator type=\"vrl\"/>") and a 32x24 film.
+std::filesystem::path writeScene(const test::TempDir& dir, const std::string& integrator,
+                                 const std::string& filmExtra = "") {
+    const std::filesystem::path file = dir / "scene.xml";
+    std::ofstream(file) << "<scene version=\"0.5.0\">\n  <default name=\"spp\" value=\"2\"/>\n  " << integrator
+                        << "\n  <sensor type=\"perspective\"><sampler type=\"independent\"><integer name=\"sampleCount\" "
+                           "value=\"$spp\"/></sampler>\n    <film type=\"hdrfilm\"><integer name=\"width\" value=\"32\"/>"
+                           "<integer name=\"height\" value=\"24\"/>"
+                        << filmExtra << "</film></sensor>\n</scene>\n";
+    return file;
+}
+
+v1::JobSpec specWithMethod(const std::string& method) {
+    v1::JobSpec spec;
+    *spec.mutable_parameters() = rpc::defaultRenderParameters(RenderMethod::Path);
+    spec.mutable_parameters()->set_method(method);
+    return spec;
+}
+
+TEST(ResolveJob, EmptyMethodTakesTheScenesIntegratorWhenItNamesOurs) {
+    const test::TempDir dir("vrl-job-scene");
+    const auto scene = writeScene(dir, "<integrator type=\"vrl\"><integer name=\"maxDepth\" value=\"4\"/></integrator>");
+    const rpc::ResolvedJob job = rpc::resolveJob(scene, specWithMethod(""), {});
+    EXPECT_EQ(job.settings.method, RenderMethod::Vrl);
+    EXPECT_EQ(job.settings.maxDepth, 4);  // the scene's integrator keeps its depth
+    for (const RenderMethod method : kRenderMethods) {
+        const auto named = writeScene(dir, "<integrator type=\"" + std::string(methodName(method)) + "\"/>");
+        EXPECT_EQ(rpc::resolveJob(named, specWithMethod(""), {}).settings.method, method) << methodName(method);
+    }
+}
+
+TEST(ResolveJob, EmptyMethodWithAnotherIntegratorIsTheHeadlineMethod) {
+    static_assert(kHeadlineMethod == RenderMethod::VrlLightcuts);
+    const test::TempDir dir("vrl-job-scene");
+    for (const std::string integrator : {"<integrator type=\"volpath\"/>", "<integrator type=\"vrlcuts\"/>",
+                                         "<integrator type=\"bdpt\"/>", ""})
+        EXPECT_EQ(rpc::resolveJob(writeScene(dir, integrator), specWithMethod(""), {}).settings.method,
+                  kHeadlineMethod)
+            << integrator;
+}
+
+TEST(ResolveJob, AnExplicitMethodWinsOverTheScenes) {
+    const test::TempDir dir("vrl-job-scene");
+    const auto scene = writeScene(dir, "<integrator type=\"vrl\"/>");
+    EXPECT_EQ(rpc::resolveJob(scene, specWithMethod("path"), {}).settings.method, RenderMethod::Path);
+    EXPECT_EQ(rpc::resolveJob(scene, specWithMethod("vpl-lightcuts"), {}).settings.method, RenderMethod::VplLightcuts);
+}
+
+TEST(ResolveJob, AMethodFromTheSceneStillNeedsLights) {
+    const test::TempDir dir("vrl-job-scene");
+    v1::JobSpec spec = specWithMethod("");
+    spec.mutable_parameters()->set_vrl_count(0);
+    try {
+        rpc::resolveJob(writeScene(dir, "<integrator type=\"vrl\"/>"), spec, {});
+        ADD_FAILURE() << "no VRLs accepted";
+    } catch (const rpc::JobSpecError& e) {
+        EXPECT_NE(std::string(e.what()).find("method vrl needs a VRL count"), std::string::npos) << e.what();
+    }
+    spec.mutable_parameters()->set_method("path");
+    EXPECT_NO_THROW(rpc::resolveJob(writeScene(dir, "<integrator type=\"vrl\"/>"), spec, {}));
+}
+
+TEST(ResolveJob, CropAppliesAfterTheResolution) {
+    const test::TempDir dir("vrl-job-scene");
+    const auto scene = writeScene(dir, "");
+    v1::JobSpec spec = specWithMethod("path");
+    auto& p = *spec.mutable_parameters();
+    p.set_width(64);
+    p.set_height(48);
+    auto& crop = *p.mutable_crop();
+    crop.set_x(40);
+    crop.set_y(30);
+    crop.set_width(24);
+    crop.set_height(18);
+    const rpc::ResolvedJob job = rpc::resolveJob(scene, spec, {});
+    EXPECT_EQ(job.description.sensor.width, 64);
+    EXPECT_EQ(job.description.sensor.crop, (FilmCrop{40, 30, 24, 18}));
+    // The same window on the scene's own 32x24 film does not fit: the message names both.
+    p.clear_width();
+    p.clear_height();
+    try {
+        rpc::resolveJob(scene, spec, {});
+        ADD_FAILURE() << "a crop outside the film was accepted";
+    } catch (const rpc::JobSpecError& e) {
+        EXPECT_NE(std::string(e.what()).find("crop window 40,30,24,18"), std::string::npos) << e.what();
+        EXPECT_NE(std::string(e.what()).find("32x24 film"), std::string::npos) << e.what();
+    }
+    crop.set_width(0);
+    EXPECT_THROW(rpc::resolveJob(scene, spec, {}), rpc::JobSpecError);
+    // The whole film is no crop.
+    crop.set_x(0);
+    crop.set_y(0);
+    crop.set_width(32);
+    crop.set_height(24);
+    EXPECT_FALSE(rpc::resolveJob(scene, spec, {}).description.sensor.crop);
+}
+
+TEST(ResolveJob, TheScenesCropMustFitAResolutionAskedFor) {
+    const test::TempDir dir("vrl-job-scene");
+    const auto scene = writeScene(dir, "", "<integer name=\"cropOffsetX\" value=\"16\"/><integer name=\"cropWidth\" "
+                                           "value=\"16\"/>");
+    v1::JobSpec spec = specWithMethod("path");
+    EXPECT_EQ(rpc::resolveJob(scene, spec, {}).description.sensor.crop, (FilmCrop{16, 0, 16, 24}));
+    spec.mutable_parameters()->set_width(20);
+    spec.mutable_parameters()->set_height(24);
+    try {
+        rpc::resolveJob(scene, spec, {});
+        ADD_FAILURE() << "the scene's crop outside a smaller film was accepted";
+    } catch (const rpc::JobSpecError& e) {
+        EXPECT_NE(std::string(e.what()).find("scene's film crop"), std::string::npos) << e.what();
+        EXPECT_NE(std::string(e.what()).find("20x24 film"), std::string::npos) << e.what();
+        EXPECT_NE(std::string(e.what()).find("--crop"), std::string::npos) << e.what();
+    }
+}
+
+TEST(ResolveJob, AnUnusedDefineFailsTheJob) {
+    const test::TempDir dir("vrl-job-scene");
+    v1::JobSpec spec = specWithMethod("path");
+    (*spec.mutable_defines())["spp"] = "1";
+    EXPECT_NO_THROW(rpc::resolveJob(writeScene(dir, ""), spec, {}));
+    (*spec.mutable_defines())["sppp"] = "1";
+    try {
+        rpc::resolveJob(writeScene(dir, ""), spec, {});
+        ADD_FAILURE() << "an unused define was accepted";
+    } catch (const SceneError& e) {
+        EXPECT_NE(std::string(e.what()).find("-D sppp=1: the scene uses no $sppp"), std::string::npos) << e.what();
+        EXPECT_NE(std::string(e.what()).find("names it uses: spp"), std::string::npos) << e.what();
+    }
+}
+
+}  // namespace
+}  // namespace vrl
