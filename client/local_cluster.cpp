@@ -33,7 +33,7 @@ pid_t LocalCluster::spawn(const std::vector<std::string>& arguments) {
     for (auto& e : environment) envp.push_back(e.data());
     envp.push_back(nullptr);
     // VRL_EXIT_WITH_PARENT makes them stop if this process dies without cleaning up.
-    environment.push_back("VRL_EXIT_WITH_PARENT=1");
+    environment.push_back("VRL_EXIT_WITH_PARENT=" + std::to_string(getpid()));
     envp.clear();
     for (auto& e : environment) envp.push_back(e.data());
     envp.push_back(nullptr);

@@ -30,8 +30,11 @@ void ProgressBar::update(double fraction, const std::string& detail) {
         const int tenth = int(fraction * 10.0);
         if (tenth == lastShown_) return;
         lastShown_ = tenth;
-        std::fprintf(stderr, "%s %3d%% (%.1fs%s%s)\n", label_.c_str(), tenth * 10, elapsed, detail.empty() ? "" : ", ",
-                     detail.c_str());
+        char eta[48] = "";
+        if (fraction > 0.0 && fraction < 1.0 && detail.empty())
+            std::snprintf(eta, sizeof eta, ", ETA %.1fs", elapsed * (1.0 - fraction) / fraction);
+        std::fprintf(stderr, "%s %3d%% (%.1fs%s%s%s)\n", label_.c_str(), tenth * 10, elapsed, eta,
+                     detail.empty() ? "" : ", ", detail.c_str());
     }
     std::fflush(stderr);
 }

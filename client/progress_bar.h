@@ -1,5 +1,6 @@
-// ProgressBar: a thread-safe progress line on stderr. On a terminal it redraws
-// in place; otherwise (logs, CI) it prints a line every 10%.
+// ProgressBar: a thread-safe progress line on stderr for one phase. On a
+// terminal it redraws in place with the elapsed time and an ETA; otherwise
+// (logs, CI, a pipe) it prints a line every 10% with the elapsed time and ETA.
 #pragma once
 
 #include <chrono>

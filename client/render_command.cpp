@@ -3,13 +3,17 @@
 #include "client/local_cluster.h"
 #include "client/progress_bar.h"
 #include "client/remote_render.h"
+#include "client/output_checks.h"
 #include "client/render_options.h"
+#include "util/system_memory.h"
+#include "util/termination_signals.h"
 #include "service/job/job_scene.h"
 #include "service/job/scene_bundle.h"
 #include "util/termination_signals.h"
 
 #include "render/core/timing.h"
 #include "render/image/exr_io.h"
+#include "render/image/partial_image.h"
 #include "render/image/preview_image.h"
 #include "render/render_metadata.h"
 #include "render/renderer.h"
@@ -22,6 +26,7 @@
 #include <tbb/task_arena.h>
 
 #include <atomic>
+#include <csignal>
 #include <chrono>
 #include <thread>
 #include <cstdio>
@@ -31,6 +36,8 @@
 namespace vrl::client {
 
 namespace {
+
+const char* signalName(int signal) { return signal == SIGTERM ? "SIGTERM" : "SIGINT"; }
 
 double peakMemoryMiB() {
     rusage usage{};
@@ -84,9 +91,16 @@ int runLocalCluster(const RenderCommandOptions& o) {
     return code;
 }
 
-int runRender(const RenderCommandOptions& o) {
+int runRender(const RenderCommandOptions& o, const CLI::App& command) {
     if (o.quiet) spdlog::set_level(spdlog::level::warn);
-    if (o.workers > 0) return runLocalCluster(o);
+    // Before any work: where the image goes (at once, from file-system metadata),
+    // then, once the scene is parsed, that it overwrites none of the scene's files.
+    checkOutputPaths(o.output, o.preview, {o.scene});
+    checkOutputPaths(o.output, o.preview, sceneInputFiles(o.scene, parseDefines(o.defines)));
+    if (o.workers > 0) {
+        warnIneffectiveFlags(command, requestedMethod(o), true);
+        return runLocalCluster(o);
+    }
     using Clock = std::chrono::steady_clock;
 
     // The same builder as the coordinator's (service/job/job_scene.h), with the
@@ -100,6 +114,8 @@ int runRender(const RenderCommandOptions& o) {
     const RenderSettings& settings = job.settings;
     const auto& sensor = description.sensor;
     const double parseSeconds = secondsSince(t0);
+    warnIneffectiveFlags(command, settings.method, false);
+    checkLightMemory(settings, util::physicalMemoryBytes());
 
     t0 = Clock::now();
     const auto scene = Scene::build(description);
@@ -107,6 +123,10 @@ int runRender(const RenderCommandOptions& o) {
 
     const int threads = o.threads > 0 ? o.threads : tbb::info::default_concurrency();
     tbb::task_arena arena(threads);
+    // SIGINT/SIGTERM stop the render between tiles; what is finished is written
+    // below as a partial image. A second signal quits at once.
+    const util::TerminationSignals signals;
+    const RenderStop stop{[&] { return signals.received() != 0; }};
     // One bar per phase ("light tracing", then "rendering").
     std::mutex barMutex;
     std::unique_ptr<ProgressBar> bar;
@@ -124,8 +144,26 @@ int runRender(const RenderCommandOptions& o) {
     };
     RenderStatistics stats;
     ImageSet images;
-    arena.execute([&] { images = render(*scene, settings, o.quiet ? ProgressCallback{} : progress, &stats); });
+    RenderCoverage coverage;
+    try {
+        arena.execute([&] {
+            images = render(*scene, settings, o.quiet ? ProgressCallback{} : progress, &stats, stop, &coverage);
+        });
+    } catch (const RenderInterrupted&) {
+        if (bar) bar->finish();
+        std::fprintf(stderr, "vrl render: %s during light preparation: no tile was rendered, no image written\n",
+                     signalName(signals.received()));
+        return util::TerminationSignals::exitCode(signals.received());
+    }
     if (bar) bar->finish();
+    if (!coverage.complete()) {
+        if (coverage.tilesDone == 0) {
+            std::fprintf(stderr, "vrl render: %s before any tile was finished: no image written\n",
+                         signalName(signals.received()));
+            return util::TerminationSignals::exitCode(signals.received());
+        }
+        markPartial(images, coverage.covered, coverage.tilesDone, coverage.tilesTotal);
+    }
 
     t0 = Clock::now();
     RenderRecord record;
@@ -141,6 +179,14 @@ int runRender(const RenderCommandOptions& o) {
     writeExr(o.output, images);
     if (!o.preview.empty()) writePreviewPng(images.image, o.preview, autoExposure(images.image));
     const double writeSeconds = secondsSince(t0);
+    if (!coverage.complete()) {
+        std::fprintf(stderr,
+                     "vrl render: %s: stopped; wrote the %d of %d tiles finished to %s (a partial image: "
+                     "unfinished pixels are 0, see its 'coverage' layer and vrl.partial)\n",
+                     signalName(signals.received()), coverage.tilesDone, coverage.tilesTotal, o.output.c_str());
+        return util::TerminationSignals::exitCode(signals.received());
+    }
+    if (o.quiet) return 0;
 
     std::fprintf(stderr,
                  "summary: %s, %dx%d, method %s, %d spp, seed %llu, %d threads\n"
@@ -183,9 +229,9 @@ void registerRenderCommand(CLI::App& app, int& exitCode) {
         ->check(CLI::Range(0, 256));
     cmd->add_option("--tile-size", o->tileSize, "With --workers: tile side in pixels (default 32)")
         ->check(CLI::Range(1u, 256u));
-    cmd->callback([o, &exitCode] {
+    cmd->callback([o, cmd, &exitCode] {
         try {
-            exitCode = runRender(*o);
+            exitCode = runRender(*o, *cmd);
         } catch (const SceneError& e) {
             std::fprintf(stderr, "vrl render: scene error: %s\n", e.what());
             exitCode = 2;

@@ -3,6 +3,11 @@
 #include "render/renderer.h"
 #include "render/scene/scene_description.h"
 
+#include <spdlog/spdlog.h>
+
+#include <cerrno>
+#include <cstdio>
+#include <cstdlib>
 #include <regex>
 #include <stdexcept>
 
@@ -20,7 +25,8 @@ void addRenderOptions(CLI::App& cmd, RenderCommandOptions& o) {
                     "Also write a tone-mapped 8-bit PNG of the image here (automatic exposure: the 99th percentile "
                     "of luminance maps near white)");
     cmd.add_option("--method", o.method,
-                    "Rendering method: path (volumetric path tracer, the reference), vrl (transport parts "
+                    "Rendering method (default: the scene's <integrator type> if it names one of these, else "
+                    "vrl-lightcuts, the headline method): path (volumetric path tracer, the reference), vrl (transport parts "
                     "(a)-(c) by path sampling, multiple scattering (d) by plain VRLs), vrl-lightcuts (the same, "
                     "(d) by cuts through a VRL light tree) or vpl-lightcuts (the paper's baseline: (d) by Lightcuts "
                     "over VPLs at the light paths' medium collisions, 32 stratified distance samples per camera "
@@ -29,8 +35,21 @@ void addRenderOptions(CLI::App& cmd, RenderCommandOptions& o) {
     cmd.add_option("--spp", o.spp, "Samples per pixel (default: the scene's sampler sampleCount)")
         ->check(CLI::Range(1, kMaxSampleCount));
     cmd.add_option("--resolution", o.resolution, "Image size WxH, overriding the scene's film (e.g. 640x480)");
-    cmd.add_option("--threads", o.threads, "Shading threads (default: all cores; with --workers: per worker, default cores / N)")->check(CLI::Range(1, 4096));
-    cmd.add_option("--seed", o.seed, "Random seed; equal seeds give bit-identical images (default 0)");
+    cmd.add_option("--threads", o.threads,
+                   "Shading threads; 0 (the default) = all cores (with --workers: per worker, default cores / N)")
+        ->check(CLI::Range(0, 4096));
+    cmd.add_option("--seed", o.seed, "Random seed, 0 ... 2^64-1 as a decimal integer; equal seeds give bit-identical images "
+                                     "(default 0)")
+        ->transform(CLI::Validator(
+            [](std::string& value) {
+                // Exactly a decimal number in range: not -1 (which would wrap), 1e3, 0x10 or 2^64.
+                static const std::regex digits("^[0-9]{1,20}$");
+                errno = 0;
+                if (!std::regex_match(value, digits)) return std::string("must be a decimal integer 0 ... 18446744073709551615");
+                (void)std::strtoull(value.c_str(), nullptr, 10);
+                return errno == ERANGE ? std::string("is above 2^64-1 = 18446744073709551615") : std::string();
+            },
+            "0..2^64-1"));
     cmd.add_option("--max-depth", o.maxDepth,
                     "Path length as Mitsuba's maxDepth: 1 emitters only, 2 direct + single scattering, -1 unlimited "
                     "(default: the scene's integrator)")
@@ -68,8 +87,57 @@ void addRenderOptions(CLI::App& cmd, RenderCommandOptions& o) {
     cmd.add_option("--partition-size", o.partitionSize,
                     "vrl-lightcuts, vpl-lightcuts: lights per partition before agglomerative clustering (default 2048)")
         ->check(CLI::Range(2u, 1u << 30));
-    cmd.add_flag("--jitter", o.jitter, "Jitter camera rays inside pixels (default: through pixel centres)");
-    cmd.add_flag("-q,--quiet", o.quiet, "No progress bar and no informational logs");
+    cmd.add_flag("--pixel-centres", o.pixelCentres,
+                 "Camera rays through pixel centres, the paper's setting (default: jittered inside each pixel, "
+                 "antialiased, as Mitsuba and pbrt do; still bit-identical across threads and workers)");
+    cmd.add_flag("-q,--quiet", o.quiet, "Warnings and errors only: no progress bars, no summary");
+}
+
+RenderMethod requestedMethod(const RenderCommandOptions& o) {
+    return o.method.empty() ? kHeadlineMethod : parseRenderMethod(o.method);
+}
+
+void warnIneffectiveFlags(const CLI::App& command, RenderMethod method, bool distributed) {
+    const bool virtualLights = usesVirtualLights(method);
+    const bool tree = usesLightTree(method);
+    const bool vrls = method == RenderMethod::Vrl || method == RenderMethod::VrlLightcuts;
+    struct Rule {
+        const char* flag;
+        bool effective;
+        const char* uses;  // which methods or modes it acts on
+    };
+    const Rule rules[] = {
+        {"--vrls", virtualLights, "the virtual-light methods"},
+        {"--light-paths", virtualLights, "the virtual-light methods"},
+        {"--transport", virtualLights, "the virtual-light methods (path renders everything)"},
+        {"--vrl-samples", vrls, "vrl and vrl-lightcuts"},
+        {"--error", tree, "vrl-lightcuts and vpl-lightcuts"},
+        {"--max-cut", tree, "vrl-lightcuts and vpl-lightcuts"},
+        {"--hg-epsilon", tree, "vrl-lightcuts and vpl-lightcuts"},
+        {"--partition-size", tree, "vrl-lightcuts and vpl-lightcuts"},
+        {"--exact-distance-below", method == RenderMethod::VrlLightcuts, "vrl-lightcuts"},
+    };
+    const std::string name(methodName(method));
+    for (const Rule& rule : rules)
+        if (!rule.effective && command.count(rule.flag) > 0)
+            spdlog::warn("{} has no effect with --method {}: it acts on {} only", rule.flag, name, rule.uses);
+    if (virtualLights && command.count("--light-paths") > 0 && command.count("--vrls") > 0)
+        spdlog::warn("--vrls has no effect with --light-paths: exactly the given light paths are traced");
+    if (!distributed && command.get_name() == "render" && command.count("--tile-size") > 0)
+        spdlog::warn("--tile-size has no effect without --workers: the embedded render schedules its own tiles");
+}
+
+void checkLightMemory(const RenderSettings& settings, uint64_t memoryBytes) {
+    const uint64_t need = estimateLightMemoryBytes(settings);
+    if (need <= memoryBytes) return;
+    char message[512];
+    std::snprintf(message, sizeof message,
+                  "--vrls %llu: the %s and their light structures need about %.1f GiB (%.0f bytes each), more than "
+                  "this machine's %.1f GiB of memory; lower --vrls",
+                  (unsigned long long)settings.vrlCount, usesVpls(settings.method) ? "VPLs" : "VRLs",
+                  double(need) / double(1ull << 30), double(need) / double(std::max<uint64_t>(1, settings.vrlCount)),
+                  double(memoryBytes) / double(1ull << 30));
+    throw std::invalid_argument(message);
 }
 
 std::map<std::string, std::string> parseDefines(const std::vector<std::string>& defines) {
@@ -95,7 +163,7 @@ v1::RenderParameters toRenderParameters(const RenderCommandOptions& o) {
     p.set_method(o.method);
     p.set_samples_per_pixel(o.spp);
     p.set_seed(o.seed);
-    p.set_jitter(o.jitter);
+    p.set_jitter(!o.pixelCentres);
     p.set_max_depth(o.maxDepth);
     if (!o.resolution.empty()) {
         const auto [w, h] = parseResolution(o.resolution);

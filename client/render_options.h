@@ -2,6 +2,7 @@
 // translation into the service's RenderParameters.
 #pragma once
 
+#include "render/renderer.h"
 #include "vrl/v1/vrl.pb.h"
 
 #include <CLI/CLI.hpp>
@@ -19,13 +20,13 @@ struct RenderCommandOptions {
     std::vector<std::string> defines;
     std::string medium;   // --medium "sigmaS=..,sigmaA=..[,g=..]": fill a scene without media
     std::string preview;  // --preview out.png: a tone-mapped PNG beside the EXR
-    std::string method = "path";
+    std::string method;  // empty: the scene's <integrator> if it names one of ours, else the headline method
     int spp = 0;  // 0: the scene's sampleCount
     std::string resolution;  // "WxH", empty: the scene's film
     int threads = 0;         // 0: all cores
     uint64_t seed = 0;
     int maxDepth = -2;  // -2: the scene's integrator maxDepth
-    bool jitter = false;
+    bool pixelCentres = false;  // rays through pixel centres (the paper's setting) instead of jittered
     bool quiet = false;
     uint64_t vrls = 100000;
     uint64_t lightPaths = 0;
@@ -43,6 +44,19 @@ struct RenderCommandOptions {
 
 // Registers the scene, output and every render flag on `cmd`.
 void addRenderOptions(CLI::App& cmd, RenderCommandOptions& o);
+
+// The method the flags ask for: --method, else the headline method (the scene's
+// <integrator> may still select another when the job is resolved).
+RenderMethod requestedMethod(const RenderCommandOptions& o);
+
+// Warns (spdlog, naming the flag and the method) about every flag given on
+// `command` that has no effect on `method` (e.g. --error with path; --tile-size
+// without --workers when `distributed` is false).
+void warnIneffectiveFlags(const CLI::App& command, RenderMethod method, bool distributed);
+
+// Throws std::invalid_argument, with the estimate, when the VRL set and light
+// tree of `settings` (estimateLightMemoryBytes) would not fit in `memoryBytes`.
+void checkLightMemory(const RenderSettings& settings, uint64_t memoryBytes);
 
 // -D name=value list into a map; throws std::invalid_argument naming a bad entry.
 std::map<std::string, std::string> parseDefines(const std::vector<std::string>& defines);

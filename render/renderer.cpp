@@ -96,6 +96,17 @@ RenderLights prepareLights(const Scene& scene, const RenderSettings& settings, c
     return lights;
 }
 
+uint64_t estimateLightMemoryBytes(const RenderSettings& settings) {
+    if (!isVrlMethod(settings) || !settings.transports.has(TransportPart::Multiple) || settings.lightPaths > 0) return 0;
+    // The light tracer's vector may double while it is filled (2 lights per
+    // light); a tree adds about 2 nodes per light plus its partitioning scratch
+    // (about one more light).
+    double perLight = 2.0 * sizeof(Vrl);
+    if (usesLightTree(settings.method)) perLight += 2.0 * sizeof(LightTreeNode) + sizeof(Vrl);
+    const double bytes = perLight * double(settings.vrlCount);
+    return bytes >= 1.8e19 ? ~uint64_t(0) : uint64_t(bytes);
+}
+
 std::vector<TileRect> imageTiles(int width, int height, int tileSize) {
     const int tile = std::max(1, tileSize);
     std::vector<TileRect> tiles;
@@ -223,15 +234,25 @@ ImageSet assembleImageSet(std::vector<Image> layers, const std::vector<std::stri
             if (name == kCutLayerNames[2]) statistics->meanCutSize = mean;
         }
         result.layers.emplace_back(name, std::move(layers[l + 1]));
+        for (const char* counter : kCutLayerNames)
+            if (name == counter) result.singleChannelLayers.insert(name);
     }
     return result;
 }
 
 ImageSet render(const Scene& scene, const RenderSettings& settings, const ProgressCallback& progress,
-                RenderStatistics* statistics) {
+                RenderStatistics* statistics, const RenderStop& stop, RenderCoverage* coverage) {
     validateRenderSettings(settings);
     RenderStatistics stats;
-    const RenderLights lights = prepareLights(scene, settings, progress, &stats);
+    const auto stopRequested = [&] { return stop.requested && stop.requested(); };
+    // Light tracing runs in TBB tasks; an exception from its progress callback
+    // cancels them and reaches the caller.
+    const ProgressCallback preparing = [&](const char* phase, double fraction) {
+        if (stopRequested()) throw RenderInterrupted();
+        if (progress) progress(phase, fraction);
+    };
+    const RenderLights lights = prepareLights(scene, settings, preparing, &stats);
+    if (stopRequested()) throw RenderInterrupted();
     const auto start = std::chrono::steady_clock::now();
     const TileShader shader(scene, settings, lights);
     const int width = scene.camera().width(), height = scene.camera().height();
@@ -239,11 +260,16 @@ ImageSet render(const Scene& scene, const RenderSettings& settings, const Progre
     const std::vector<TileRect> tiles = imageTiles(width, height, settings.tileSize);
     std::atomic<uint64_t> boundExceeded{0}, boundedEstimates{0};
     std::atomic<long long> pixelsDone{0};
+    std::atomic<int> tilesDone{0};
+    std::vector<uint8_t> tileFinished(tiles.size(), 0);
     const double totalPixels = double(width) * height;
     tbb::parallel_for(tbb::blocked_range<size_t>(0, tiles.size(), 1), [&](const tbb::blocked_range<size_t>& range) {
         for (size_t t = range.begin(); t < range.end(); ++t) {
+            if (stopRequested()) return;
             const TileRect& tile = tiles[t];
             TileImages images = shader.renderTile(tile);
+            tileFinished[t] = 1;
+            ++tilesDone;
             for (size_t l = 0; l < layers.size(); ++l)
                 for (int y = 0; y < tile.height(); ++y)
                     std::copy_n(&images.layers[l].at(0, y), tile.width(), &layers[l].at(tile.x0, tile.y0 + y));
@@ -254,6 +280,15 @@ ImageSet render(const Scene& scene, const RenderSettings& settings, const Progre
             if (progress) progress("rendering", double(done) / totalPixels);
         }
     });
+    if (coverage) {
+        coverage->tilesTotal = int(tiles.size());
+        coverage->tilesDone = tilesDone.load();
+        coverage->covered.assign(size_t(width) * height, 0);
+        for (size_t t = 0; t < tiles.size(); ++t)
+            if (tileFinished[t])
+                for (int y = tiles[t].y0; y < tiles[t].y1; ++y)
+                    std::fill_n(&coverage->covered[size_t(y) * width + tiles[t].x0], tiles[t].width(), uint8_t(1));
+    }
     ImageSet result = assembleImageSet(std::move(layers), shader.layerNames(), &stats);
     stats.boundExceeded = boundExceeded.load();
     stats.boundedEstimates = boundedEstimates.load();

@@ -15,6 +15,7 @@
 #include <cstdint>
 #include <functional>
 #include <memory>
+#include <stdexcept>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -27,7 +28,7 @@ namespace vrl {
 //   path: the volumetric path tracer (reference), one image
 //   vrl:  the four transport parts, multiple scattering by plain VRLs; one layer per part
 //   vrl-lightcuts: the same, multiple scattering by cuts through a VRL light tree,
-//         plus per-pixel layers "eval", "inter" and "cut" (statistics)
+//         plus single-channel per-pixel layers "eval", "inter" and "cut" (statistics)
 //   vpl:  the four parts, multiple scattering by plain VPLs (every VPL at each of
 //         the distance samples; the brute force VPL Lightcuts is measured against)
 //   vpl-lightcuts: the same layers as vrl-lightcuts, multiple scattering by VPL
@@ -37,6 +38,9 @@ enum class RenderMethod { Path, Vrl, VrlLightcuts, Vpl, VplLightcuts };
 inline constexpr std::array<RenderMethod, 5> kRenderMethods = {RenderMethod::Path, RenderMethod::Vrl,
                                                                RenderMethod::VrlLightcuts, RenderMethod::Vpl,
                                                                RenderMethod::VplLightcuts};
+
+// The method the README recommends, used when a job names none.
+inline constexpr RenderMethod kHeadlineMethod = RenderMethod::VrlLightcuts;
 
 // "path", "vrl", "vrl-lightcuts", "vpl", "vpl-lightcuts".
 std::string_view methodName(RenderMethod method);
@@ -105,6 +109,12 @@ struct RenderLights {
 RenderLights prepareLights(const Scene& scene, const RenderSettings& settings, const ProgressCallback& progress = {},
                            RenderStatistics* statistics = nullptr);
 
+// Peak memory of prepareLights for `settings` (0 when it prepares nothing): the
+// target VRL (or VPL) count times the bytes of a light, with the light tracer's
+// batch growth, plus the tree's nodes and build scratch for the tree methods.
+// With --light-paths the count is not known in advance and this returns 0.
+uint64_t estimateLightMemoryBytes(const RenderSettings& settings);
+
 // Pixels [x0, x1) x [y0, y1) of the image.
 struct TileRect {
     int x0 = 0, y0 = 0, x1 = 0, y1 = 0;
@@ -145,13 +155,35 @@ private:
 };
 
 // Whole-image layers (one per TileShader layer, image first) into an ImageSet,
-// filling the cut statistics of `statistics` from the "eval", "inter", "cut" layers.
+// filling the cut statistics of `statistics` from the "eval", "inter", "cut" layers
+// (which it marks single-channel).
 ImageSet assembleImageSet(std::vector<Image> layers, const std::vector<std::string>& layerNames,
                           RenderStatistics* statistics = nullptr);
 
+// Stopping a render early (an interrupt): `requested` is polled before each
+// tile and from the light-tracing progress. Tiles already started finish; the
+// others stay zero. When it fires during light preparation, render throws
+// RenderInterrupted (nothing was shaded).
+struct RenderStop {
+    std::function<bool()> requested;
+};
+struct RenderInterrupted : std::runtime_error {
+    RenderInterrupted() : std::runtime_error("interrupted before any tile was shaded") {}
+};
+// Which tiles a render finished: `covered` has one entry per pixel (row-major,
+// 1 where a finished tile covers it), for partial_image.h's markPartial.
+struct RenderCoverage {
+    std::vector<uint8_t> covered;
+    int tilesDone = 0, tilesTotal = 0;
+    bool complete() const { return tilesDone == tilesTotal; }
+};
+
 // prepareLights, then every tile in parallel (TBB), then assembleImageSet.
 // The vrl method returns the sum in .image and each selected part as a layer.
+// With `stop`, tiles not started when it fires are skipped (zero) and
+// `coverage`, if given, says which were finished.
 ImageSet render(const Scene& scene, const RenderSettings& settings, const ProgressCallback& progress = {},
-                RenderStatistics* statistics = nullptr);
+                RenderStatistics* statistics = nullptr, const RenderStop& stop = {},
+                RenderCoverage* coverage = nullptr);
 
 }  // namespace vrl

@@ -3,7 +3,7 @@
 #include "server/coordinator_service.h"
 #include "util/atomic_file.h"
 #include "util/duration.h"
-#include "util/signals.h"
+#include "util/termination_signals.h"
 
 #include <CLI/CLI.hpp>
 #include <spdlog/spdlog.h>
@@ -90,11 +90,13 @@ int coordinatorMain(int argc, char** argv) {
     options.heartbeatInterval = std::max(std::chrono::milliseconds(10), options.heartbeatTimeout / 5);
     options.limits.maxBundleBytes = maxBundleMiB << 20;
 
-    sigset_t signals;
-    if (!util::takeTerminationSignals(signals)) return 1;  // started by `vrl render --workers`, whose process is gone
+    if (!util::exitWithParent()) return 1;  // started by `vrl render --workers`, whose process is gone
 
     std::optional<tbb::global_control> threadLimit;
     if (threads > 0) threadLimit.emplace(tbb::global_control::max_allowed_parallelism, size_t(threads));
+    // A second signal does not cut the drain short: `vrl render --workers` sends
+    // SIGTERM after the terminal's SIGINT reached the whole process group.
+    util::TerminationSignals signals(false);
     try {
         server.token = rpc::loadToken(tokenFile);
         Coordinator coordinator(options);
@@ -105,7 +107,8 @@ int coordinatorMain(int argc, char** argv) {
             util::writeFileAtomically(portFile, std::to_string(service.port()) + "\n");
         }
         int signal = 0;
-        sigwait(&signals, &signal);
+        while ((signal = signals.wait(std::chrono::hours(1))) == 0) {
+        }
         spdlog::info("signal {}: draining leases (at most {} s)", signal, drainTimeout);
         service.shutdown(std::chrono::milliseconds(int64_t(drainTimeout * 1000)));
         spdlog::info("stopped");

@@ -1,11 +1,13 @@
 #include "worker/worker_main.h"
 
-#include "util/signals.h"
+#include "util/termination_signals.h"
 #include "worker/worker.h"
 
 #include <CLI/CLI.hpp>
 #include <spdlog/spdlog.h>
 
+#include <atomic>
+#include <chrono>
 #include <csignal>
 #include <cstdio>
 #include <unistd.h>
@@ -46,16 +48,20 @@ int workerMain(int argc, char** argv) {
         return 2;
     }
     spdlog::set_level(spdlog::level::from_str(logLevel));
-    sigset_t signals;
-    if (!util::takeTerminationSignals(signals)) return 1;  // started by `vrl render --workers`, whose process is gone
+    if (!util::exitWithParent()) return 1;
+    util::TerminationSignals signals(false);  // started by `vrl render --workers`, whose process is gone
     try {
         options.token = rpc::loadToken(tokenFile);
         Worker worker(options);
+        std::atomic<bool> finished{false};
         std::thread signalThread([&] {
-            int signal = 0;
-            sigwait(&signals, &signal);
-            spdlog::info("signal {}: finishing the tiles in flight", signal);
-            worker.stop();
+            while (!finished) {
+                if (const int signal = signals.wait(std::chrono::milliseconds(200))) {
+                    spdlog::info("signal {}: finishing the tiles in flight", signal);
+                    worker.stop();
+                    return;
+                }
+            }
         });
         int code = 0;
         try {
@@ -67,7 +73,7 @@ int workerMain(int argc, char** argv) {
             spdlog::error("{}", e.what());
             code = 1;
         }
-        kill(getpid(), SIGTERM);  // wakes the signal thread if no signal came
+        finished = true;
         signalThread.join();
         return code;
     } catch (const std::exception& e) {

@@ -60,6 +60,8 @@ void checkWritable(const std::filesystem::path& path, const ImageSet& images) {
             fail("layer '" + name + "' is " + std::to_string(layer.width()) + "x" + std::to_string(layer.height()) +
                  " but the image is " + std::to_string(image.width()) + "x" + std::to_string(image.height()));
     }
+    for (const auto& name : images.singleChannelLayers)
+        if (!names.count(name)) fail("single-channel layer '" + name + "' is not among the layers");
     for (const auto& entry : images.metadata) {
         if (entry.first.empty() || entry.first.size() > kMaxNameLength)
             fail("metadata key '" + entry.first + "' must have 1 to " + std::to_string(kMaxNameLength) + " characters");
@@ -103,15 +105,29 @@ ImageSet readExrFile(const std::filesystem::path& path) {
     for (const std::string& name : layerNames) {
         bool complete = true;
         for (const char* component : kComponents) complete = complete && channels.findChannel(name + "." + component);
-        if (complete) result.layers.emplace_back(name, Image(int(width), int(height)));
+        if (complete) {
+            result.layers.emplace_back(name, Image(int(width), int(height)));
+        } else if (channels.findChannel(name + ".Y") && !channels.findChannel(name + ".R") &&
+                   !channels.findChannel(name + ".G") && !channels.findChannel(name + ".B")) {
+            result.layers.emplace_back(name, Image(int(width), int(height)));
+            result.singleChannelLayers.insert(name);
+        }
     }
-    for (const auto& [name, layer] : result.layers)
+    for (const auto& [name, layer] : result.layers) {
+        if (result.singleChannelLayers.count(name)) {
+            frameBuffer.insert(name + ".Y", componentSlice(layer, 0, dataWindow));
+            continue;
+        }
         for (int c = 0; c < 3; ++c) frameBuffer.insert(name + "." + kComponents[c], componentSlice(layer, c, dataWindow));
+    }
 
     file.setFrameBuffer(frameBuffer);
     file.readPixels(dataWindow.min.y, dataWindow.max.y);
     if (grey)
         for (size_t i = 0; i < result.image.pixelCount(); ++i) result.image[i] = Rgb(result.image[i].x);
+    for (auto& [name, layer] : result.layers)
+        if (result.singleChannelLayers.count(name))
+            for (size_t i = 0; i < layer.pixelCount(); ++i) layer[i] = Rgb(layer[i].x);
 
     for (auto it = header.begin(); it != header.end(); ++it) {
         const std::string name = it.name();
@@ -145,7 +161,14 @@ void writeExr(const std::filesystem::path& path, const ImageSet& images) {
         }
     };
     addRgb("", image);
-    for (const auto& [name, layer] : images.layers) addRgb(name + ".", layer);
+    for (const auto& [name, layer] : images.layers) {
+        if (images.singleChannelLayers.count(name)) {
+            header.channels().insert(name + ".Y", Imf::Channel(Imf::FLOAT));
+            frameBuffer.insert(name + ".Y", componentSlice(layer, 0, dataWindow));
+        } else {
+            addRgb(name + ".", layer);
+        }
+    }
 
     try {
         // A key naming a standard attribute of another type (e.g. "channels") throws here.

@@ -1,5 +1,6 @@
 // EXR input/output for ImageSet: the image as 32-bit float channels R, G, B,
-// each layer as "<name>.R", "<name>.G", "<name>.B", and the metadata as typed
+// each layer as "<name>.R", "<name>.G", "<name>.B" (a single-channel layer as
+// "<name>.Y"), and the metadata as typed
 // attributes of the header (string, int, float, double, M44f).
 #pragma once
 
@@ -16,7 +17,8 @@ namespace vrl {
 // (util/atomic_file.h), so `path` is either left untouched or replaced by a
 // complete file.
 // Throws std::invalid_argument (naming the path) for an empty image, a layer
-// whose size differs from the image, an empty or duplicate layer name, a name
+// whose size differs from the image, an empty or duplicate layer name, a
+// single-channel name that is no layer, a name
 // or key longer than OpenEXR's 255 characters, or the key "type" (OpenEXR's
 // part type); std::runtime_error naming the path for any I/O or OpenEXR
 // failure (e.g. a missing directory, a key naming a standard attribute).
@@ -24,7 +26,8 @@ void writeExr(const std::filesystem::path& path, const ImageSet& images);
 
 // Reads the first part of an EXR file, whichever tool wrote it: channels
 // R, G, B (or, if none of them is present, a single Y channel as grey) into
-// `image`; every complete "<layer>.R/.G/.B" triple into `layers`, ordered by
+// `image`; every complete "<layer>.R/.G/.B" triple, and every lone "<layer>.Y"
+// (listed in singleChannelLayers, grey in memory), into `layers`, ordered by
 // layer name (EXR stores channels sorted); every string attribute except the
 // part "type", and every int, float, double and M44f attribute whose name starts
 // with "vrl." or is worldToCamera / worldToNDC, into `metadata`. Other channels and attributes are ignored.

@@ -11,6 +11,7 @@
 
 #include <cstddef>
 #include <map>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -40,7 +41,11 @@ private:
 struct ImageSet {
     Image image;                                // the final image ("R", "G", "B" channels)
     std::vector<std::pair<std::string, Image>> layers;  // written as "<name>.R" etc.
-    Metadata metadata;                                  // EXR header attributes
+    // Layers that hold one number per pixel (counters such as "eval", the
+    // "coverage" of a partial render): kept grey (R = G = B) in memory, written
+    // as the single channel "<name>.Y".
+    std::set<std::string> singleChannelLayers;
+    Metadata metadata;  // EXR header attributes
 };
 
 }  // namespace vrl

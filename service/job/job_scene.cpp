@@ -49,7 +49,7 @@ void validateJobSpec(const v1::JobSpec& spec, const ServiceLimits& limits) {
     const auto& p = spec.parameters();
     RenderMethod method;
     try {
-        method = parseRenderMethod(p.method());
+        method = p.method().empty() ? kHeadlineMethod : parseRenderMethod(p.method());
     } catch (const std::invalid_argument& e) {
         throw JobSpecError(e.what());
     }
@@ -143,7 +143,7 @@ ResolvedJob resolveJob(const std::filesystem::path& sceneFile, const v1::JobSpec
                            " is outside the supported range (1.." + std::to_string(kMaxFilmSide) +
                            " per side, at most " + std::to_string(limits.maxPixels) + " pixels)");
     RenderSettings& s = job.settings;
-    s.method = parseRenderMethod(p.method());
+    s.method = p.method().empty() ? kHeadlineMethod : parseRenderMethod(p.method());
     s.samplesPerPixel = p.samples_per_pixel() > 0 ? p.samples_per_pixel() : sensor.sampleCount;
     s.seed = p.seed();
     s.jitter = p.jitter();

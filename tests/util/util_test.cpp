@@ -6,10 +6,17 @@
 #include "util/duration.h"
 #include "util/hash.h"
 #include "util/random_id.h"
-#include "util/signals.h"
+#include "util/termination_signals.h"
 #include "util/strings.h"
 
 #include <gtest/gtest.h>
+
+#include <sys/prctl.h>
+
+#include <chrono>
+#include <csignal>
+#include <cstdlib>
+#include <stdexcept>
 
 #include <pthread.h>
 
@@ -113,18 +120,49 @@ TEST(UtilStrings, AbbreviateKeepsShortTextAndCutsLongText) {
     EXPECT_EQ(util::abbreviate(std::string(100, 'x'), 4), "xxxx... (100 bytes)");
 }
 
-TEST(UtilSignals, BlocksInterruptAndTerminate) {
-    sigset_t before;
-    pthread_sigmask(SIG_SETMASK, nullptr, &before);
-    sigset_t taken;
-    EXPECT_TRUE(util::takeTerminationSignals(taken));  // VRL_EXIT_WITH_PARENT is not set here
-    sigset_t now;
-    pthread_sigmask(SIG_SETMASK, nullptr, &now);
-    EXPECT_TRUE(sigismember(&now, SIGINT));
-    EXPECT_TRUE(sigismember(&now, SIGTERM));
-    EXPECT_TRUE(sigismember(&taken, SIGINT));
-    EXPECT_TRUE(sigismember(&taken, SIGTERM));
-    pthread_sigmask(SIG_SETMASK, &before, nullptr);
+TEST(UtilSignals, TakesTheFirstSignalAndWakesWait) {
+    util::TerminationSignals signals(false);
+    EXPECT_EQ(signals.received(), 0);
+    EXPECT_EQ(signals.wait(std::chrono::milliseconds(1)), 0);  // nothing yet: the timeout
+    std::raise(SIGTERM);
+    EXPECT_EQ(signals.wait(std::chrono::seconds(5)), SIGTERM);
+    std::raise(SIGINT);  // a second signal is ignored when it does not exit
+    EXPECT_EQ(signals.received(), SIGTERM);
+    EXPECT_EQ(util::TerminationSignals::exitCode(SIGINT), 130);
+    EXPECT_EQ(util::TerminationSignals::exitCode(SIGTERM), 143);
+}
+
+TEST(UtilSignals, OnlyOneOwnerAndTheHandlersAreRestored) {
+    struct sigaction before {};
+    sigaction(SIGINT, nullptr, &before);
+    {
+        util::TerminationSignals signals;
+        EXPECT_THROW(util::TerminationSignals second, std::logic_error);
+    }
+    struct sigaction after {};
+    sigaction(SIGINT, nullptr, &after);
+    EXPECT_EQ(after.sa_handler, before.sa_handler);
+    util::TerminationSignals again;  // the slot is free once the first is gone
+}
+
+TEST(UtilSignalsDeathTest, ASecondInterruptQuitsAtOnce) {
+    EXPECT_EXIT(
+        {
+            util::TerminationSignals signals;
+            std::raise(SIGINT);
+            std::raise(SIGINT);
+            std::_Exit(0);  // not reached
+        },
+        testing::ExitedWithCode(130), "");
+}
+
+TEST(UtilSignals, ExitWithParentIsANoOpOutsideLocalClusters) {
+    ::unsetenv("VRL_EXIT_WITH_PARENT");
+    EXPECT_TRUE(util::exitWithParent());
+    ::setenv("VRL_EXIT_WITH_PARENT", "1", 1);  // a parent pid that is not ours: the parent is gone
+    EXPECT_FALSE(util::exitWithParent());
+    ::unsetenv("VRL_EXIT_WITH_PARENT");
+    prctl(PR_SET_PDEATHSIG, 0);
 }
 
 }  // namespace

@@ -1,4 +1,5 @@
 #include "render/image/exr_io.h"
+#include "render/image/partial_image.h"
 #include "tests/support/temp_dir.h"
 
 #include <gtest/gtest.h>
@@ -6,6 +7,7 @@
 #include <OpenEXR/ImfChannelList.h>
 #include <OpenEXR/ImfFrameBuffer.h>
 #include <OpenEXR/ImfHeader.h>
+#include <OpenEXR/ImfInputFile.h>
 #include <OpenEXR/ImfOutputFile.h>
 
 #include <Imath/half.h>
@@ -19,6 +21,7 @@
 #include <iterator>
 #include <limits>
 #include <random>
+#include <set>
 #include <string>
 #include <utility>
 #include <vector>
@@ -113,6 +116,54 @@ TEST_F(ExrIoTest, RoundTripIsBitExact) {
     EXPECT_EQ(read.layers[1].first, "transport.single");
     expectBitExact(written.layers[0].second, read.layers[1].second, "layer transport.single");
     EXPECT_EQ(read.metadata, written.metadata);
+}
+
+// Counter layers are one channel ("eval.Y"), read back grey and still marked single-channel.
+TEST_F(ExrIoTest, SingleChannelLayersRoundTripAsOneChannel) {
+    ImageSet written;
+    written.image = randomImage(5, 4, 1);
+    Image counts(5, 4);
+    for (size_t i = 0; i < counts.pixelCount(); ++i) counts[i] = Rgb(float(i * 7));
+    written.layers = {{"eval", counts}, {"surface", randomImage(5, 4, 2)}};
+    written.singleChannelLayers = {"eval"};
+    const fs::path path = dir_ / "single.exr";
+    writeExr(path, written);
+    {
+        Imf::InputFile file(path.c_str());
+        const Imf::ChannelList& channels = file.header().channels();
+        EXPECT_TRUE(channels.findChannel("eval.Y"));
+        EXPECT_FALSE(channels.findChannel("eval.R"));
+        EXPECT_TRUE(channels.findChannel("surface.R"));
+    }
+    const ImageSet read = readExr(path);
+    ASSERT_EQ(read.layers.size(), 2u);
+    EXPECT_EQ(read.layers[0].first, "eval");
+    expectBitExact(counts, read.layers[0].second, "eval");
+    EXPECT_EQ(read.singleChannelLayers, std::set<std::string>{"eval"});
+
+    written.singleChannelLayers = {"nosuch"};
+    EXPECT_THROW(writeExr(dir_ / "bad.exr", written), std::invalid_argument);
+}
+
+// A partial image carries its coverage (one channel) and vrl.partial / vrl.tilesTotal.
+TEST_F(ExrIoTest, PartialImageCarriesCoverageAndTileCounts) {
+    ImageSet images;
+    images.image = randomImage(4, 2, 3);
+    std::vector<uint8_t> covered = {1, 1, 0, 0, 1, 1, 0, 0};
+    markPartial(images, covered, 1, 2);
+    const fs::path path = dir_ / "partial.exr";
+    writeExr(path, images);
+    const ImageSet read = readExr(path);
+    ASSERT_EQ(read.layers.size(), 1u);
+    EXPECT_EQ(read.layers[0].first, kCoverageLayer);
+    for (size_t i = 0; i < covered.size(); ++i) EXPECT_EQ(read.layers[0].second[i].x, covered[i] ? 1.0f : 0.0f);
+    EXPECT_EQ(std::get<int32_t>(read.metadata.at(kPartialKey)), 1);
+    EXPECT_EQ(std::get<int32_t>(read.metadata.at(kTilesTotalKey)), 2);
+    EXPECT_THROW(markPartial(images, covered, 1, 2), std::invalid_argument);  // already partial
+    ImageSet other;
+    other.image = randomImage(4, 2, 3);
+    EXPECT_THROW(markPartial(other, {1, 0}, 1, 2), std::invalid_argument);   // wrong coverage size
+    EXPECT_THROW(markPartial(other, covered, 3, 2), std::invalid_argument);  // more tiles done than exist
 }
 
 // Numbers stay numbers: int, float, double and M44f attributes come back with their
