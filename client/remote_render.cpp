@@ -98,7 +98,7 @@ public:
     void show(const v1::JobProgress& p) {
         if (quiet_) return;
         if (p.state() == v1::JOB_STATE_PREPARING) {
-            begin(p.preparing_phase().empty() ? "preparing" : p.preparing_phase());
+            begin(p.preparing_phase().empty() ? "loading the scene" : p.preparing_phase());
             bar_->update(std::clamp(p.preparing_fraction(), 0.0, 1.0));
         } else if (p.state() == v1::JOB_STATE_RENDERING && p.tiles_total() > 0) {
             begin("rendering");

@@ -94,8 +94,8 @@ int coordinatorMain(int argc, char** argv) {
 
     std::optional<tbb::global_control> threadLimit;
     if (threads > 0) threadLimit.emplace(tbb::global_control::max_allowed_parallelism, size_t(threads));
-    // A second signal does not cut the drain short: `vrl render --workers` sends
-    // SIGTERM after the terminal's SIGINT reached the whole process group.
+    // A second signal does not cut the drain short (the children of `vrl render --workers` run in a
+    // process group of their own and are stopped by their client's SIGTERM, or by PR_SET_PDEATHSIG).
     util::TerminationSignals signals(false);
     try {
         server.token = rpc::loadToken(tokenFile);

@@ -22,7 +22,7 @@ pass() { echo "submit_test: ok: $*"; }
 free_port() { python3 -c 'import socket; s=socket.socket(); s.bind(("127.0.0.1", 0)); print(s.getsockname()[1])'; }
 now_ms() { date +%s%3N; }
 addr=127.0.0.1:$(free_port)
-flags=(--resolution 160x120 --spp 200 --tile-size 8 --seed 3)  # ~8 s on one worker thread
+flags=(--method path --resolution 160x120 --spp 200 --tile-size 8 --seed 3)  # ~8 s on one worker thread
 
 start_coordinator() {
   "$coordinator_bin" --listen "$addr" --state-dir "$work/state" --threads 1 --max-bundle-mib 1 \
@@ -113,7 +113,7 @@ grep -q "is unavailable" "$work/attach.err" && grep -q "re-attached to job $J" "
 pass "--attach survived a coordinator restart: $(grep -E 'unavailable|re-attached' "$work/attach.err" | tr '\n' '|')"
 
 # 7. SIGTERM while watching: exit 143, and the printed cancel command works.
-K=$("$vrl" submit --detach "$scene" --coordinator "$addr" -o "$work/b.exr" --resolution 160x120 --spp 64 --tile-size 8 \
+K=$("$vrl" submit --detach "$scene" --coordinator "$addr" -o "$work/b.exr" --method path --resolution 160x120 --spp 64 --tile-size 8 \
   2> /dev/null) || fail "second submit"
 "$vrl" submit --attach "$K" --coordinator "$addr" -o "$work/b.exr" 2> "$work/term.err" &
 watcher=$!; pids+=("$watcher")
@@ -127,7 +127,7 @@ cancel=$(sed -n 's/^ *cancel: *vrl //p' "$work/term.err")
 pass "SIGTERM: exit 143; 'vrl $cancel' cancelled the job"
 
 # 8. -q: warnings and errors only (and the summary); stdout empty.
-"$vrl" submit -q "$scene" --coordinator "$addr" -o "$work/q.exr" --resolution 32x24 --spp 1 > "$work/q.out" 2> "$work/q.err" \
+"$vrl" submit -q "$scene" --coordinator "$addr" -o "$work/q.exr" --method path --resolution 32x24 --spp 1 > "$work/q.out" 2> "$work/q.err" \
   || fail "submit -q failed"
 [ -s "$work/q.out" ] && fail "stdout of submit -q is not empty"
 grep -Eq "submitted|rendering|bundle" "$work/q.err" && fail "submit -q printed progress: $(cat "$work/q.err")"
