@@ -3,8 +3,9 @@
 #  - SIGINT 3 s in: the tiles finished so far are written as a partial EXR that
 #    `vrl compare` reads, the message says where and how many tiles, exit 130,
 #    and no $TMPDIR/vrl-local-* folder is left;
-#  - `kill -9` of the client: its coordinator and workers stop (PR_SET_PDEATHSIG)
-#    and the folder is gone within a few seconds.
+#  - `kill -9` of the client, or a second Ctrl-C (which quits at once): its
+#    coordinator and workers stop (PR_SET_PDEATHSIG) and the folder is gone
+#    within a few seconds.
 set -u
 vrl=$1 scene=$2
 work=$(mktemp -d)
@@ -42,4 +43,17 @@ while left; do
   sleep 0.2
 done
 echo "workers_interrupt_test: ok: kill -9: the folder was gone after $((SECONDS - deadline + 15)) s"
-echo "workers_interrupt_test: 2 passed, 0 failed"
+
+# 3. Two Ctrl-C in a row: the second quits at once (exit 130), and the folder still goes.
+"$vrl" render "$scene" -o "$work/twice.exr" "${flags[@]}" > /dev/null 2> "$work/twice.err" &
+render=$!; pids+=("$render")
+sleep 2
+kill -INT "$render"; sleep 0.05; kill -INT "$render"; wait "$render"; code=$?
+[ "$code" -eq 130 ] || fail "two Ctrl-C: exit $code, expected 130"
+deadline=$((SECONDS + 15))
+while left; do
+  [ "$SECONDS" -ge "$deadline" ] && fail "a vrl-local-* folder was left 15 s after a second Ctrl-C"
+  sleep 0.2
+done
+echo "workers_interrupt_test: ok: a second Ctrl-C: exit 130, no folder left"
+echo "workers_interrupt_test: 3 passed, 0 failed"
