@@ -2,12 +2,14 @@
 
 #include "render/image/exr_io.h"
 #include "render/image/image_metrics.h"
+#include "render/image/partial_image.h"
 
 #include <cstdio>
 #include <cstring>
 #include <memory>
 #include <set>
 #include <string>
+#include <utility>
 
 namespace vrl::client {
 
@@ -35,6 +37,14 @@ void registerCompareCommand(CLI::App& app, int& exitCode) {
         try {
             const ImageSet reference = readExr(paths->first);
             const ImageSet image = readExr(paths->second);
+            // A partial render (interrupted) is compared like any image, but say so: its missing tiles are zero.
+            for (const auto& [path, set] : {std::pair{&paths->first, &reference}, std::pair{&paths->second, &image}}) {
+                const auto partial = set->metadata.find(kPartialKey), total = set->metadata.find(kTilesTotalKey);
+                if (partial != set->metadata.end())
+                    std::fprintf(stderr, "note: %s is a partial render: %s of %s tiles (unfinished pixels are 0)\n",
+                                 path->c_str(), metadataText(partial->second).c_str(),
+                                 total != set->metadata.end() ? metadataText(total->second).c_str() : "?");
+            }
             const ImageErrorMetrics m = compareImages(reference.image, image.image);
             std::printf("pixels         %zu\n", m.pixels);
             std::printf("RMSE           %.6g\n", m.rmse);

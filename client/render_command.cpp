@@ -37,6 +37,12 @@ namespace vrl::client {
 
 namespace {
 
+double coveredFraction(const RenderCoverage& coverage) {
+    size_t covered = 0;
+    for (const uint8_t c : coverage.covered) covered += c != 0;
+    return coverage.covered.empty() ? 0.0 : double(covered) / double(coverage.covered.size());
+}
+
 const char* signalName(int signal) { return signal == SIGTERM ? "SIGTERM" : "SIGINT"; }
 
 double peakMemoryMiB() {
@@ -157,8 +163,8 @@ int runRender(const RenderCommandOptions& o, const CLI::App& command) {
     }
     if (bar) bar->finish();
     if (!coverage.complete()) {
-        if (coverage.tilesDone == 0) {
-            std::fprintf(stderr, "vrl render: %s before any tile was finished: no image written\n",
+        if (coverage.rowsDone == 0) {
+            std::fprintf(stderr, "vrl render: %s before any pixel row was finished: no image written\n",
                          signalName(signals.received()));
             return util::TerminationSignals::exitCode(signals.received());
         }
@@ -181,9 +187,10 @@ int runRender(const RenderCommandOptions& o, const CLI::App& command) {
     const double writeSeconds = secondsSince(t0);
     if (!coverage.complete()) {
         std::fprintf(stderr,
-                     "vrl render: %s: stopped; wrote the %d of %d tiles finished to %s (a partial image: "
-                     "unfinished pixels are 0, see its 'coverage' layer and vrl.partial)\n",
-                     signalName(signals.received()), coverage.tilesDone, coverage.tilesTotal, o.output.c_str());
+                     "vrl render: %s: stopped; wrote what was finished to %s: %d of %d tiles whole, %.1f%% of the "
+                     "pixels (a partial image: unfinished pixels are 0, see its 'coverage' layer and vrl.partial)\n",
+                     signalName(signals.received()), o.output.c_str(), coverage.tilesDone, coverage.tilesTotal,
+                     100.0 * coveredFraction(coverage));
         return util::TerminationSignals::exitCode(signals.received());
     }
     if (o.quiet) return 0;

@@ -21,6 +21,7 @@ int main(int argc, char** argv) {
     int exitCode = 0;
     vrl::client::registerRenderCommand(app, exitCode);
     vrl::client::registerCompareCommand(app, exitCode);
+    vrl::client::registerInfoCommand(app, exitCode);
     vrl::client::registerServiceCommands(app, exitCode);
     app.footer("Also: `vrl coordinator --help` and `vrl worker --help` (the vrl-coordinator and vrl-worker programs).");
     spdlog::set_pattern("[%l] %v");

@@ -26,7 +26,7 @@ void writeRenderMetadata(const RenderRecord& record, const PerspectiveCamera& ca
 
     if (usesVirtualLights(s.method)) {
         metadata["vrl.transport"] = s.transports.toString();
-        metadata["vrl.vrlSamples"] = int32_t(s.vrlSamples);
+        if (!usesVpls(s.method)) metadata["vrl.vrlSamples"] = int32_t(s.vrlSamples);
         metadata[usesVpls(s.method) ? "vrl.vpls" : "vrl.vrls"] = double(stats.vrlCount);
         metadata["vrl.lightPaths"] = double(stats.lightPaths);
         metadata["vrl.time.lightTracing"] = stats.tracingSeconds;

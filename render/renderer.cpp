@@ -168,7 +168,7 @@ TileShader::TileShader(const Scene& scene, const RenderSettings& settings, const
 
 TileShader::~TileShader() = default;
 
-TileImages TileShader::renderTile(const TileRect& tile) const {
+TileImages TileShader::renderTile(const TileRect& tile, const RenderStop& stop) const {
     const PerspectiveCamera& camera = scene_.camera();
     const int width = camera.width();
     if (tile.x0 < 0 || tile.y0 < 0 || tile.x1 > width || tile.y1 > camera.height() || tile.x0 >= tile.x1 ||
@@ -179,6 +179,11 @@ TileImages TileShader::renderTile(const TileRect& tile) const {
     out.layers.assign(1 + layerNames_.size(), Image(w, h));
     const float spp = float(settings_.samplesPerPixel);
     for (int y = tile.y0; y < tile.y1; ++y) {
+        if (stop()) {
+            out.interrupted = true;
+            out.rowsDone = y - tile.y0;
+            return out;
+        }
         for (int x = tile.x0; x < tile.x1; ++x) {
             Rng rng(settings_.seed, uint64_t(y) * uint64_t(width) + uint64_t(x));
             const int tx = x - tile.x0, ty = y - tile.y0;
@@ -244,7 +249,7 @@ ImageSet render(const Scene& scene, const RenderSettings& settings, const Progre
                 RenderStatistics* statistics, const RenderStop& stop, RenderCoverage* coverage) {
     validateRenderSettings(settings);
     RenderStatistics stats;
-    const auto stopRequested = [&] { return stop.requested && stop.requested(); };
+    const auto stopRequested = [&] { return stop(); };
     // Light tracing runs in TBB tasks; an exception from its progress callback
     // cancels them and reaches the caller.
     const ProgressCallback preparing = [&](const char* phase, double fraction) {
@@ -261,18 +266,21 @@ ImageSet render(const Scene& scene, const RenderSettings& settings, const Progre
     std::atomic<uint64_t> boundExceeded{0}, boundedEstimates{0};
     std::atomic<long long> pixelsDone{0};
     std::atomic<int> tilesDone{0};
-    std::vector<uint8_t> tileFinished(tiles.size(), 0);
+    std::vector<int> tileRows(tiles.size(), 0);  // rows shaded per tile
     const double totalPixels = double(width) * height;
+    if (progress) progress("rendering", 0.0);
     tbb::parallel_for(tbb::blocked_range<size_t>(0, tiles.size(), 1), [&](const tbb::blocked_range<size_t>& range) {
         for (size_t t = range.begin(); t < range.end(); ++t) {
             if (stopRequested()) return;
             const TileRect& tile = tiles[t];
-            TileImages images = shader.renderTile(tile);
-            tileFinished[t] = 1;
-            ++tilesDone;
+            TileImages images = shader.renderTile(tile, stop);
+            const int rows = images.interrupted ? images.rowsDone : tile.height();
+            tileRows[t] = rows;
             for (size_t l = 0; l < layers.size(); ++l)
-                for (int y = 0; y < tile.height(); ++y)
+                for (int y = 0; y < rows; ++y)
                     std::copy_n(&images.layers[l].at(0, y), tile.width(), &layers[l].at(tile.x0, tile.y0 + y));
+            if (images.interrupted) return;
+            ++tilesDone;
             boundExceeded += images.boundExceeded;
             boundedEstimates += images.boundedEstimates;
             const long long count = static_cast<long long>(tile.width()) * tile.height();
@@ -283,11 +291,13 @@ ImageSet render(const Scene& scene, const RenderSettings& settings, const Progre
     if (coverage) {
         coverage->tilesTotal = int(tiles.size());
         coverage->tilesDone = tilesDone.load();
+        coverage->rowsDone = 0;
         coverage->covered.assign(size_t(width) * height, 0);
-        for (size_t t = 0; t < tiles.size(); ++t)
-            if (tileFinished[t])
-                for (int y = tiles[t].y0; y < tiles[t].y1; ++y)
-                    std::fill_n(&coverage->covered[size_t(y) * width + tiles[t].x0], tiles[t].width(), uint8_t(1));
+        for (size_t t = 0; t < tiles.size(); ++t) {
+            coverage->rowsDone += tileRows[t];
+            for (int y = tiles[t].y0; y < tiles[t].y0 + tileRows[t]; ++y)
+                std::fill_n(&coverage->covered[size_t(y) * width + tiles[t].x0], tiles[t].width(), uint8_t(1));
+        }
     }
     ImageSet result = assembleImageSet(std::move(layers), shader.layerNames(), &stats);
     stats.boundExceeded = boundExceeded.load();

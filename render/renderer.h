@@ -125,10 +125,21 @@ struct TileRect {
 // The image cut into tileSize x tileSize tiles, row by row from the top left.
 std::vector<TileRect> imageTiles(int width, int height, int tileSize);
 
+// Stopping a render early (an interrupt): `requested` is polled from the
+// light-tracing progress, before each tile and before each row of a tile. A
+// tile stopped midway keeps its finished rows (the rest stay zero); when it
+// fires during light preparation, render throws RenderInterrupted.
+struct RenderStop {
+    std::function<bool()> requested;
+    bool operator()() const { return requested && requested(); }
+};
+
 // Layers of a tile or image, in order: the image itself, then the method's layers.
 struct TileImages {
     std::vector<Image> layers;  // each tile-sized; layers[0] is the image
     uint64_t boundExceeded = 0, boundedEstimates = 0;
+    bool interrupted = false;  // `stop` fired before the last row: only the first `rowsDone` rows are shaded
+    int rowsDone = 0;
 };
 
 // Names of the layers after the image that `settings` produce ("surface", ...,
@@ -144,7 +155,7 @@ public:
     ~TileShader();
     // Names of the layers after the image ("surface", ..., "eval", "inter", "cut").
     const std::vector<std::string>& layerNames() const { return layerNames_; }
-    TileImages renderTile(const TileRect& tile) const;
+    TileImages renderTile(const TileRect& tile, const RenderStop& stop = {}) const;
 
 private:
     const Scene& scene_;
@@ -160,21 +171,16 @@ private:
 ImageSet assembleImageSet(std::vector<Image> layers, const std::vector<std::string>& layerNames,
                           RenderStatistics* statistics = nullptr);
 
-// Stopping a render early (an interrupt): `requested` is polled before each
-// tile and from the light-tracing progress. Tiles already started finish; the
-// others stay zero. When it fires during light preparation, render throws
-// RenderInterrupted (nothing was shaded).
-struct RenderStop {
-    std::function<bool()> requested;
-};
 struct RenderInterrupted : std::runtime_error {
     RenderInterrupted() : std::runtime_error("interrupted before any tile was shaded") {}
 };
-// Which tiles a render finished: `covered` has one entry per pixel (row-major,
-// 1 where a finished tile covers it), for partial_image.h's markPartial.
+// What a render finished: `covered` has one entry per pixel (row-major, 1 where
+// the pixel was shaded: finished tiles and the finished rows of tiles stopped
+// midway), for partial_image.h's markPartial; tilesDone counts whole tiles.
 struct RenderCoverage {
     std::vector<uint8_t> covered;
     int tilesDone = 0, tilesTotal = 0;
+    int rowsDone = 0;  // pixel rows shaded, over all tiles (0: nothing to keep)
     bool complete() const { return tilesDone == tilesTotal; }
 };
 

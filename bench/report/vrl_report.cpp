@@ -555,7 +555,7 @@ int main(int argc, char** argv) {
     app.add_option("--scenes", o.only, "Only these scenes (names as in the summary), comma-separated")->delimiter(',');
     app.add_option("--shared", o.shared, "The shared scene folder with staircase/, veach-lamp-mitsuba-bidir/, "
                                          "volumetric-caustic/ (default ../shared/scenes beside the repository)");
-    app.add_option("--threads", o.threads, "Threads (default: all cores)")->check(CLI::Range(1, 4096));
+    app.add_option("--threads", o.threads, "Threads; 0 (the default) = all cores")->check(CLI::Range(0, 4096));
     app.add_option("--python", o.python, "Python with matplotlib for the plots (default /usr/bin/python3)");
     bool noPlots = false;
     app.add_flag("--no-plots", noPlots, "Skip the plots (CSV, images and summary only)");
