@@ -184,6 +184,7 @@ private:
 std::string submitScene(JobClient& client, const RenderCommandOptions& o, const RemoteOptions& remote) {
     if (o.scene.empty())
         throw std::invalid_argument("give a scene file to submit, or --attach JOB to re-attach to a submitted job");
+    checkOutputPaths(o.output, o.preview, {o.scene});  // at once, before the scene is even parsed
     v1::JobSpec spec = makeJobSpec(o);
     spec.set_priority(remote.priority);
     std::vector<std::filesystem::path> inputs;
