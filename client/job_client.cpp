@@ -5,7 +5,10 @@
 #include "util/atomic_file.h"
 #include "util/hash.h"
 
+#include <condition_variable>
 #include <fstream>
+#include <mutex>
+#include <thread>
 
 namespace vrl::client {
 
@@ -21,6 +24,14 @@ void check(const grpc::Status& status, const std::string& call) {
 
 JobClient::JobClient(const std::string& address, const rpc::TlsOptions& tls, std::string token)
     : channel_(rpc::makeChannel(address, tls)), stub_(v1::JobService::NewStub(channel_)), token_(std::move(token)) {}
+
+v1::ServiceInfo JobClient::serviceInfo(std::chrono::milliseconds timeout) {
+    grpc::ClientContext context;
+    rpc::prepareContext(context, token_, timeout);
+    v1::ServiceInfo reply;
+    check(stub_->GetServiceInfo(&context, v1::GetServiceInfoRequest(), &reply), "GetServiceInfo");
+    return reply;
+}
 
 std::string JobClient::uploadBundle(const std::string& blob, bool* uploaded) {
     const std::string sha256 = util::sha256Hex(blob);
@@ -66,33 +77,81 @@ std::string JobClient::submit(const v1::JobSpec& spec) {
 }
 
 v1::JobProgress JobClient::watch(const std::string& jobId,
-                                 const std::function<void(const v1::JobProgress&)>& onProgress) {
-    v1::JobProgress last;
-    // Long jobs: re-attach every 10 minutes so no single call needs an unbounded deadline.
-    while (true) {
-        grpc::ClientContext context;
-        rpc::prepareContext(context, token_, 10min);
-        v1::JobRef ref;
-        ref.set_job_id(jobId);
-        auto reader = stub_->WatchJob(&context, ref);
-        v1::JobProgress progress;
-        while (reader->Read(&progress)) {
-            last = progress;
-            if (onProgress) onProgress(progress);
+                                 const std::function<void(const v1::JobProgress&)>& onProgress,
+                                 const std::function<bool()>& interrupted) {
+    // The current call's context, cancelled from the polling thread once `interrupted` says so.
+    std::mutex mutex;
+    std::condition_variable done;
+    grpc::ClientContext* current = nullptr;
+    bool stop = false, finished = false;
+    std::thread poller;
+    if (interrupted)
+        poller = std::thread([&] {
+            std::unique_lock lock(mutex);
+            while (!finished && !stop) {
+                done.wait_for(lock, 100ms);
+                if (finished) break;
+                lock.unlock();
+                const bool interrupt = interrupted();
+                lock.lock();
+                if (interrupt) {
+                    stop = true;
+                    if (current) current->TryCancel();
+                }
+            }
+        });
+    const auto endPoller = [&] {
+        {
+            std::lock_guard lock(mutex);
+            finished = true;
         }
-        const grpc::Status status = reader->Finish();
-        const auto state = last.state();
-        if (state == v1::JOB_STATE_DONE || state == v1::JOB_STATE_FAILED || state == v1::JOB_STATE_CANCELLED)
-            return last;
-        if (status.error_code() != grpc::StatusCode::DEADLINE_EXCEEDED) check(status, "WatchJob");
+        done.notify_all();
+        if (poller.joinable()) poller.join();
+    };
+    v1::JobProgress last;
+    try {
+        // Long jobs: re-attach every 10 minutes so no single call needs an unbounded deadline.
+        while (true) {
+            grpc::ClientContext context;
+            rpc::prepareContext(context, token_, 10min);
+            {
+                std::lock_guard lock(mutex);
+                if (stop) throw WatchInterrupted();
+                current = &context;
+            }
+            v1::JobRef ref;
+            ref.set_job_id(jobId);
+            auto reader = stub_->WatchJob(&context, ref);
+            v1::JobProgress progress;
+            while (reader->Read(&progress)) {
+                last = progress;
+                if (onProgress) onProgress(progress);
+            }
+            const grpc::Status status = reader->Finish();
+            {
+                std::lock_guard lock(mutex);
+                current = nullptr;
+                if (stop) throw WatchInterrupted();
+            }
+            const auto state = last.state();
+            if (state == v1::JOB_STATE_DONE || state == v1::JOB_STATE_FAILED || state == v1::JOB_STATE_CANCELLED)
+                break;
+            if (status.error_code() != grpc::StatusCode::DEADLINE_EXCEEDED) check(status, "WatchJob");
+        }
+    } catch (...) {
+        endPoller();
+        throw;
     }
+    endPoller();
+    return last;
 }
 
-void JobClient::fetchImage(const std::string& jobId, const std::filesystem::path& path) {
+void JobClient::fetchImage(const std::string& jobId, const std::filesystem::path& path, bool partial) {
     grpc::ClientContext context;
     rpc::prepareContext(context, token_, 30min);
     v1::JobRef ref;
     ref.set_job_id(jobId);
+    ref.set_partial(partial);
     auto reader = stub_->FetchImage(&context, ref);
     std::string blob, sha256;
     uint64_t total = 0;
@@ -131,12 +190,24 @@ std::vector<v1::JobProgress> JobClient::list() {
     return {reply.jobs().begin(), reply.jobs().end()};
 }
 
-std::string collectSceneBundle(const std::filesystem::path& scene, const std::map<std::string, std::string>& defines) {
+v1::PurgeJobsReply JobClient::purge(std::chrono::milliseconds olderThan) {
+    grpc::ClientContext context;
+    rpc::prepareContext(context, token_, 5min);
+    v1::PurgeJobsRequest request;
+    request.set_older_than_ms(olderThan.count());
+    v1::PurgeJobsReply reply;
+    check(stub_->PurgeJobs(&context, request, &reply), "PurgeJobs");
+    return reply;
+}
+
+std::string collectSceneBundle(const std::filesystem::path& scene, const std::map<std::string, std::string>& defines,
+                               std::vector<std::filesystem::path>* referenced) {
     ParseOptions options;
     options.defines = defines;
     std::vector<std::filesystem::path> files;
     options.onFileReferenced = [&](const std::filesystem::path& file) { files.push_back(file); };
     (void)parseMitsubaScene(scene, options);  // also reports scene errors before anything is sent
+    if (referenced) *referenced = files;
     return rpc::makeBundleBlob(scene, files);
 }
 

@@ -32,14 +32,18 @@ pid_t LocalCluster::spawn(const std::vector<std::string>& arguments) {
     std::vector<char*> envp;
     for (auto& e : environment) envp.push_back(e.data());
     envp.push_back(nullptr);
-    // Same process group: Ctrl-C reaches the children too (they stop gracefully);
     // VRL_EXIT_WITH_PARENT makes them stop if this process dies without cleaning up.
     environment.push_back("VRL_EXIT_WITH_PARENT=" + std::to_string(getpid()));
     envp.clear();
     for (auto& e : environment) envp.push_back(e.data());
     envp.push_back(nullptr);
+    posix_spawnattr_t attributes;
+    posix_spawnattr_init(&attributes);
+    posix_spawnattr_setflags(&attributes, POSIX_SPAWN_SETPGROUP);
+    posix_spawnattr_setpgroup(&attributes, 0);  // a group of its own: the terminal's Ctrl-C is this process's
     pid_t pid = 0;
-    const int error = posix_spawn(&pid, "/proc/self/exe", nullptr, nullptr, argv.data(), envp.data());
+    const int error = posix_spawn(&pid, "/proc/self/exe", nullptr, &attributes, argv.data(), envp.data());
+    posix_spawnattr_destroy(&attributes);
     if (error != 0) throw std::runtime_error("cannot start '" + arguments[0] + " " + arguments[1] + "'");
     return pid;
 }
@@ -51,7 +55,8 @@ LocalCluster::LocalCluster(int workers, int threadsPerWorker, const std::string&
     const fs::path portFile = stateDir_ / "port";
     processes_.emplace_back("coordinator", spawn({"vrl", "coordinator", "--listen", "127.0.0.1:0", "--state-dir",
                                                   (stateDir_ / "state").string(), "--port-file", portFile.string(),
-                                                  "--log-level", logLevel, "--drain-timeout", "5"}));
+                                                  "--log-level", logLevel, "--drain-timeout", "5",
+                                                  "--retention", "0", "--remove-on-exit", stateDir_.string()}));
     const auto until = std::chrono::steady_clock::now() + 30s;
     while (!fs::exists(portFile)) {
         if (!exitedProcesses().empty()) throw std::runtime_error("the local coordinator exited at start");

@@ -9,6 +9,7 @@
 #include "util/termination_signals.h"
 #include "service/job/job_scene.h"
 #include "service/job/scene_bundle.h"
+#include "util/termination_signals.h"
 
 #include "render/core/timing.h"
 #include "render/image/exr_io.h"
@@ -57,10 +58,15 @@ int runLocalCluster(const RenderCommandOptions& o) {
     if (!o.quiet)
         std::fprintf(stderr, "starting a local coordinator and %d workers (%d threads each)\n", o.workers,
                      threadsPerWorker);
+    // Ctrl-C / SIGTERM: keep the finished tiles as a partial EXR, then stop (a second one: at once).
+    util::TerminationSignals signals;
     LocalCluster cluster(o.workers, threadsPerWorker, "warn");
     RemoteOptions remote;
     remote.address = cluster.address();
     remote.token = cluster.token();
+    remote.retryFor = std::chrono::seconds(0);  // the local coordinator does not come back
+    remote.noWorkerWarning = std::chrono::milliseconds(0);
+    remote.partialOnSignal = true;
     // If every worker dies, cancel the job rather than wait for ever (a dead coordinator ends the watch by itself).
     std::atomic<bool> finished{false};
     std::thread watchdog([&] {
@@ -80,7 +86,7 @@ int runLocalCluster(const RenderCommandOptions& o) {
     });
     int code = 1;
     try {
-        code = runRemoteRender(o, remote);
+        code = runRemoteRender(o, remote, signals);
     } catch (...) {
         finished = true;
         watchdog.join();

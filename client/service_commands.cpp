@@ -6,8 +6,14 @@
 #include "grpc/health/v1/health.grpc.pb.h"
 #include "render/scene/scene_error.h"
 #include "service/job/scene_bundle.h"
+#include "util/duration.h"
+#include "util/termination_signals.h"
 
+#include <spdlog/spdlog.h>
+
+#include <chrono>
 #include <cstdio>
+#include <ctime>
 #include <cstdlib>
 #include <memory>
 
@@ -41,6 +47,25 @@ const char* stateName(v1::JobState state) {
         case v1::JOB_STATE_CANCELLED: return "cancelled";
         default: return "?";
     }
+}
+
+// A wall-clock time in ms since the epoch as local "YYYY-MM-DD HH:MM:SS"; "-" for none.
+std::string whenText(int64_t unixMs) {
+    if (unixMs <= 0) return "-";
+    const std::time_t seconds = std::time_t(unixMs / 1000);
+    std::tm local{};
+    localtime_r(&seconds, &local);
+    char text[32];
+    std::strftime(text, sizeof text, "%Y-%m-%d %H:%M:%S", &local);
+    return text;
+}
+
+// How long ago: "3d 4h", "12m 5s"; "-" for none.
+std::string agoText(int64_t unixMs) {
+    if (unixMs <= 0) return "-";
+    const auto now = std::chrono::duration_cast<std::chrono::milliseconds>(
+        std::chrono::system_clock::now().time_since_epoch());
+    return util::formatDuration(now - std::chrono::milliseconds(unixMs));
 }
 
 // Runs body, mapping errors to exit codes: bad input 2, the rest 1.
@@ -81,28 +106,65 @@ void registerServiceCommands(CLI::App& app, int& exitCode) {
         cmd->add_option("--tile-size", o->tileSize, "Tile side in pixels (default 32)")->check(CLI::Range(1u, 256u));
         cmd->add_flag("--detach", remote->detach, "Print the job id once submitted and exit (re-attach with --attach)");
         cmd->add_option("--attach", remote->attachJob,
-                        "Re-attach to a submitted job by id: wait for it and write its image (the scene is not read)");
-        cmd->callback([o, c, remote, &exitCode] {
+                        "Re-attach to a submitted job by id: wait for it and write its image (no scene needed)");
+        cmd->get_option("scene")->required(false);  // not with --attach; checked in runRemoteRender
+        auto retryFor = std::make_shared<int>(300);
+        cmd->add_option("--retry-for", *retryFor,
+                        "Seconds to keep retrying (with backoff) a coordinator that became unreachable, e.g. while it "
+                        "restarts; then exit 1 with the command to re-attach")
+            ->capture_default_str()->check(CLI::Range(0, 7 * 86400));
+        auto noWorkerSeconds = std::make_shared<double>(15.0);
+        cmd->add_option("--no-worker-warning", *noWorkerSeconds, "")->group("");  // hidden: tests use 1 s
+        cmd->callback([o, c, remote, retryFor, noWorkerSeconds, &exitCode] {
             exitCode = guarded("submit", [&] {
+                if (o->quiet) spdlog::set_level(spdlog::level::warn);
                 remote->address = c->address;
                 remote->tls = c->tls;
+                remote->tokenFile = c->tokenFile;
                 remote->token = rpc::loadToken(c->tokenFile);
-                return runRemoteRender(*o, *remote);
+                remote->retryFor = std::chrono::seconds(*retryFor);
+                remote->noWorkerWarning = std::chrono::milliseconds(int64_t(*noWorkerSeconds * 1000));
+                util::TerminationSignals signals;  // Ctrl-C: leave the job running, say how to re-attach
+                return runRemoteRender(*o, *remote, signals);
             });
         });
     }
     {
         auto c = std::make_shared<ConnectionFlags>();
-        auto* cmd = app.add_subcommand("jobs", "List a coordinator's jobs");
+        auto purge = std::make_shared<bool>(false);
+        auto olderThan = std::make_shared<std::string>("0");
+        auto* cmd = app.add_subcommand("jobs", "List a coordinator's jobs (submitted when, how long ago, finished "
+                                               "when), or purge its finished ones");
         addConnectionFlags(*cmd, *c);
-        cmd->callback([c, &exitCode] {
+        cmd->add_flag("--purge", *purge,
+                      "Delete finished jobs (done, failed, cancelled) now, with their images and the scene bundles no "
+                      "other job uses; prints what it deleted");
+        cmd->add_option("--older-than", *olderThan,
+                        "With --purge: only jobs that ended at least this long ago (e.g. 7d, 12h, 30m, 90s; default: "
+                        "every finished job)");
+        cmd->callback([c, purge, olderThan, &exitCode] {
             exitCode = guarded("jobs", [&] {
+                const auto age = util::parseDuration(*olderThan);  // std::invalid_argument: exit 2
                 JobClient client(c->address, c->tls, rpc::loadToken(c->tokenFile));
-                std::printf("%-18s %-10s %8s %9s  %s\n", "JOB", "STATE", "PRIORITY", "TILES", "SCENE");
+                if (*purge) {
+                    const v1::PurgeJobsReply reply = client.purge(age);
+                    for (const auto& j : reply.purged())
+                        std::printf("purged %s  %s, finished %s, %s\n", j.job_id().c_str(), stateName(j.state()),
+                                    whenText(j.finished_unix_ms()).c_str(), j.name().c_str());
+                    std::printf("purged %d jobs and %u scene bundles, %.1f MiB freed\n", reply.purged_size(),
+                                reply.bundles_removed(), double(reply.bytes_freed()) / double(1 << 20));
+                    return 0;
+                }
+                std::printf("%-18s %-10s %8s %9s  %-19s %9s %-13s %s\n", "JOB", "STATE", "PRIORITY", "TILES",
+                            "SUBMITTED", "AGE", "FINISHED", "SCENE");
                 for (const auto& j : client.list()) {
-                    std::printf("%-18s %-10s %8d %4u/%-4u  %s%s%s\n", j.job_id().c_str(), stateName(j.state()),
-                                j.priority(), j.tiles_done(), j.tiles_total(), j.name().c_str(),
-                                j.message().empty() ? "" : "  -- ", j.message().c_str());
+                    const std::string finished =
+                        j.finished_unix_ms() > 0 ? agoText(j.finished_unix_ms()) + " ago" : std::string("-");
+                    std::printf("%-18s %-10s %8d %4u/%-4u  %-19s %9s %-13s %s%s%s\n", j.job_id().c_str(),
+                                stateName(j.state()), j.priority(), j.tiles_done(), j.tiles_total(),
+                                whenText(j.submitted_unix_ms()).c_str(), agoText(j.submitted_unix_ms()).c_str(),
+                                finished.c_str(), j.name().c_str(), j.message().empty() ? "" : "  -- ",
+                                j.message().c_str());
                 }
                 return 0;
             });

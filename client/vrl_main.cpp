@@ -7,9 +7,12 @@
 
 #include <cstring>
 
+#include <spdlog/sinks/stdout_color_sinks.h>
 #include <spdlog/spdlog.h>
 
 int main(int argc, char** argv) {
+    // Logs go to stderr, in every mode: stdout holds results only (e.g. J=$(vrl submit --detach ...)).
+    spdlog::set_default_logger(spdlog::stderr_color_mt("vrl"));
     if (argc >= 2 && std::strcmp(argv[1], "coordinator") == 0) return vrl::server::coordinatorMain(argc - 1, argv + 1);
     if (argc >= 2 && std::strcmp(argv[1], "worker") == 0) return vrl::worker::workerMain(argc - 1, argv + 1);
     CLI::App app{"vrl: scalable virtual ray lights (VRL Lightcuts) renderer for participating media"};

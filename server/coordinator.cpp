@@ -2,6 +2,7 @@
 
 #include "render/core/timing.h"
 #include "server/tile_assembly.h"
+#include "service/common/rpc_common.h"
 #include "service/job/job_scene.h"
 #include "util/strings.h"
 
@@ -18,6 +19,11 @@ using Clock = std::chrono::steady_clock;
 namespace {
 
 constexpr size_t kMaxMessageBytes = 4096;  // a job's failure message as stored and shown
+constexpr auto kOrphanBundleAge = std::chrono::hours(1);  // a bundle no job uses is kept this long after its upload
+
+std::chrono::milliseconds purgePeriod(std::chrono::milliseconds retention) {
+    return std::clamp<std::chrono::milliseconds>(retention / 10, std::chrono::milliseconds(100), std::chrono::minutes(10));
+}
 
 }  // namespace
 
@@ -27,6 +33,8 @@ Coordinator::Coordinator(CoordinatorOptions options)
       workers_(options_.heartbeatInterval, options_.heartbeatTimeout),
       leases_(store_, options_.leaseTimeout),
       preparation_(store_, options_.limits) {
+    if (options_.retention.count() > 0) purgeLocked(options_.retention);  // no thread runs yet
+    nextPurge_ = Clock::now() + purgePeriod(options_.retention);
     preparer_ = std::thread([this] { prepareLoop(); });
     reaper_ = std::thread([this] { reaperLoop(); });
 }
@@ -63,6 +71,7 @@ std::string Coordinator::submitJob(const v1::JobSpec& spec) {
     auto job = store_.newJob(spec);
     if (draining()) throw ServiceError(ErrorKind::FailedPrecondition, "the coordinator is shutting down");
     store_.writeSpec(*job);
+    store_.writeRecord(*job);  // its submit time, kept across restarts
     const std::string id = job->id;
     {
         std::lock_guard lock(mutex_);
@@ -80,9 +89,13 @@ v1::JobProgress Coordinator::jobProgress(const std::string& jobId) const {
 
 uint64_t Coordinator::waitForChange(const std::string& jobId, uint64_t seen, std::chrono::milliseconds timeout) const {
     std::unique_lock lock(mutex_);
-    const Job& job = store_.find(jobId);
-    changed_.wait_for(lock, timeout, [&] { return job.version != seen || stopping_; });
-    return job.version;
+    (void)store_.find(jobId);
+    // Looked up again on each wake-up: a finished job may be purged meanwhile (then NotFound).
+    changed_.wait_for(lock, timeout, [&] {
+        const auto it = store_.jobs().find(jobId);
+        return it == store_.jobs().end() || it->second->version != seen || stopping_;
+    });
+    return store_.find(jobId).version;
 }
 
 std::vector<v1::JobProgress> Coordinator::listJobs() const {
@@ -108,6 +121,65 @@ fs::path Coordinator::imageFile(const std::string& jobId) const {
     return job.dir / "image.exr";
 }
 
+std::string Coordinator::partialImage(const std::string& jobId) const {
+    PartialImageInput input;
+    {
+        std::lock_guard lock(mutex_);
+        const Job& job = store_.find(jobId);
+        if (job.state == v1::JOB_STATE_DONE) return rpc::readFileText((job.dir / "image.exr").string());
+        if (job.state != v1::JOB_STATE_RENDERING)
+            throw ServiceError(ErrorKind::FailedPrecondition, "job '" + jobId + "' has no tiles to show (state " +
+                                                                  v1::JobState_Name(job.state) + ")");
+        input = partialImageInput(job);  // a copy: assembled and encoded without the lock
+    }
+    return assemblePartialImage(std::move(input), store_.stateDir() / "jobs" / jobId);
+}
+
+v1::PurgeJobsReply Coordinator::purgeJobs(std::chrono::milliseconds olderThan) {
+    std::lock_guard lock(mutex_);
+    return purgeLocked(olderThan);
+}
+
+v1::PurgeJobsReply Coordinator::purgeLocked(std::chrono::milliseconds olderThan) {
+    v1::PurgeJobsReply reply;
+    const int64_t before = unixMillisecondsNow() - olderThan.count();
+    std::vector<std::string> ids;
+    for (const Job* job : store_.bySequence()) {
+        if (!isTerminal(job->state) || job == preparing_) continue;
+        // A job finished before finish times were recorded counts as finished at its submission.
+        const int64_t finished = job->finishedUnixMs > 0 ? job->finishedUnixMs : job->submittedUnixMs;
+        if (olderThan.count() > 0 && finished > before) continue;
+        *reply.add_purged() = progressOf(*job);
+        ids.push_back(job->id);
+    }
+    uint32_t bundles = 0;
+    reply.set_bytes_freed(store_.purge(ids, kOrphanBundleAge, &bundles));
+    reply.set_bundles_removed(bundles);
+    if (!ids.empty() || bundles > 0)
+        spdlog::info("purged {} finished jobs and {} bundles ({} bytes)", ids.size(), bundles, reply.bytes_freed());
+    if (!ids.empty()) changed_.notify_all();  // watchers of a purged job learn it is gone
+    return reply;
+}
+
+v1::ServiceInfo Coordinator::serviceInfo() const {
+    v1::ServiceInfo info;
+    info.set_program_version(VRL_VERSION);
+    info.set_protocol_version(rpc::kProtocolVersion);
+    const rpc::ServiceLimits& l = options_.limits;
+    auto* limits = info.mutable_limits();
+    limits->set_max_bundle_bytes(l.maxBundleBytes);
+    limits->set_max_bundle_files(l.maxBundleFiles);
+    limits->set_max_vrls(l.maxVrls);
+    limits->set_max_pixels(l.maxPixels);
+    limits->set_max_tile_size(l.maxTileSize);
+    limits->set_max_tiles(l.maxTiles);
+    limits->set_max_samples_per_pixel(l.maxSamplesPerPixel);
+    info.set_retention_ms(options_.retention.count());
+    std::lock_guard lock(mutex_);
+    info.set_workers_connected(uint32_t(workers_.count()));
+    return info;
+}
+
 void Coordinator::touch(Job& job) {
     ++job.version;
     changed_.notify_all();
@@ -115,6 +187,7 @@ void Coordinator::touch(Job& job) {
 
 void Coordinator::endJob(Job& job, v1::JobState state, const std::string& message) {
     job.state = state;
+    job.finishedUnixMs = unixMillisecondsNow();
     job.message = util::abbreviate(message, kMaxMessageBytes);  // shown in every listing: bounded
     leases_.dropJob(job);
     job.layers.clear();
@@ -137,17 +210,21 @@ void Coordinator::prepareLoop() {
             changed_.wait(lock, [&] { return stopping_ || (next = preparation_.next()) != nullptr; });
             if (stopping_) return;
             next->state = v1::JOB_STATE_PREPARING;
+            preparing_ = next;  // not purged while prepare() holds it, even if cancelled meanwhile
             touch(*next);
         }
-        prepare(*next);  // jobs are never erased, so the pointer stays valid
+        prepare(*next);
+        std::lock_guard lock(mutex_);
+        preparing_ = nullptr;
     }
 }
 
 void Coordinator::prepare(Job& job) {
     try {
-        const PreparedJob prepared = preparation_.prepare(job, [&](const char*, double f) {
+        const PreparedJob prepared = preparation_.prepare(job, [&](const char* phase, double f) {
             std::lock_guard lock(mutex_);
-            if (std::abs(f - job.preparingFraction) >= 0.01 || f >= 1.0) {
+            if (job.preparingPhase != phase || std::abs(f - job.preparingFraction) >= 0.01 || f >= 1.0) {
+                job.preparingPhase = phase;
                 job.preparingFraction = f;
                 touch(job);
             }
@@ -303,6 +380,10 @@ void Coordinator::reaperLoop() {
         const auto now = Clock::now();
         workers_.forgetSilent(now);
         statistics_.leasesExpired += leases_.requeueExpired(now, workers_);
+        if (options_.retention.count() > 0 && now >= nextPurge_) {
+            purgeLocked(options_.retention);
+            nextPurge_ = now + purgePeriod(options_.retention);
+        }
     }
 }
 

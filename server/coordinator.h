@@ -15,9 +15,13 @@
 // values) before they are accepted. A tile refused or given up maxTileRejections times fails its job.
 //
 // What survives a restart (same --state-dir): uploaded bundles, every job's
-// spec, finished jobs (their EXR and record), and the accepted tiles of
+// spec and submit time, finished jobs (their EXR, record and finish time), and the accepted tiles of
 // unfinished jobs (a checkpoint log): such jobs are prepared again (the light
 // tree is deterministic) and resume with only their missing tiles.
+//
+// Retention: finished jobs older than options.retention (by finish time) are
+// purged at start and then every min(retention / 10, 10 min), with their files
+// and the bundles no remaining job uses; purgeJobs does the same on demand.
 //
 // The work is done by its parts: JobStore (job_store.h: jobs, state directory,
 // checkpoints, blobs), JobPreparation (job_preparation.h), LeaseScheduler
@@ -58,6 +62,7 @@ struct CoordinatorOptions {
     std::chrono::milliseconds heartbeatTimeout{10000};  // a silent worker is forgotten, its leases requeued
     int maxTileRejections = 3;                          // invalid results for one tile before the job fails
     rpc::ServiceLimits limits;
+    std::chrono::milliseconds retention{std::chrono::hours(24 * 7)};  // 0: keep finished jobs for ever
 };
 
 // Counters for logs and the benchmark.
@@ -85,6 +90,13 @@ public:
     std::vector<v1::JobProgress> listJobs() const;
     // The finished job's EXR; FailedPrecondition while it is not done.
     std::filesystem::path imageFile(const std::string& jobId) const;
+    // The tiles finished so far as EXR bytes (tile_assembly.h: assemblePartialImage); a done job's
+    // whole image; FailedPrecondition before rendering starts or once the job failed or was cancelled.
+    std::string partialImage(const std::string& jobId) const;
+    // Purges the finished jobs that ended at least `olderThan` ago (0: all finished jobs).
+    v1::PurgeJobsReply purgeJobs(std::chrono::milliseconds olderThan);
+    // Versions, limits, connected workers, retention (not whether a token is required: the gRPC layer knows).
+    v1::ServiceInfo serviceInfo() const;
 
     // --- workers
     // Refuses (FailedPrecondition) another protocol or program version, naming both.
@@ -114,6 +126,7 @@ private:
     void endJob(Job& job, v1::JobState state, const std::string& message);  // lock held
     void countFailure(Job& job, uint32_t tile, const std::string& reason);  // lock held
     void touch(Job& job);                                                    // lock held: version++ and notify
+    v1::PurgeJobsReply purgeLocked(std::chrono::milliseconds olderThan);      // lock held
 
     CoordinatorOptions options_;
     // The one lock: every part below is called with it held (except JobStore's and
@@ -124,6 +137,8 @@ private:
     WorkerRegistry workers_;
     LeaseScheduler leases_;
     JobPreparation preparation_;
+    const Job* preparing_ = nullptr;  // the job prepare() works on without the lock: never purged
+    std::chrono::steady_clock::time_point nextPurge_;
     bool draining_ = false, stopping_ = false;
     CoordinatorStatistics statistics_;
     std::thread preparer_, reaper_;

@@ -2,6 +2,7 @@
 
 #include "server/coordinator_service.h"
 #include "util/atomic_file.h"
+#include "util/duration.h"
 #include "util/termination_signals.h"
 
 #include <CLI/CLI.hpp>
@@ -9,6 +10,9 @@
 #include <tbb/global_control.h>
 
 #include <csignal>
+#include <cstdio>
+#include <filesystem>
+#include <memory>
 #include <fstream>
 #include <optional>
 
@@ -20,7 +24,7 @@ int coordinatorMain(int argc, char** argv) {
     app.set_version_flag("--version", std::string("vrl-coordinator ") + VRL_VERSION + " (protocol vrl.v1)");
     ServerOptions server;
     CoordinatorOptions options;
-    std::string tokenFile, portFile, logLevel = "info";
+    std::string tokenFile, portFile, logLevel = "info", retention = "7d", removeOnExit;
     double leaseTimeout = 30.0, heartbeatTimeout = 10.0, drainTimeout = 30.0;
     int threads = 0;
     uint64_t maxBundleMiB = options.limits.maxBundleBytes >> 20;
@@ -53,6 +57,13 @@ int coordinatorMain(int argc, char** argv) {
     app.add_option("--max-vrls", options.limits.maxVrls, "most VRLs (or light paths) one job may ask for")
         ->capture_default_str();
     app.add_option("--max-pixels", options.limits.maxPixels, "most pixels in one image")->capture_default_str();
+    app.add_option("--retention", retention,
+                   "finished jobs (done, failed, cancelled) are deleted this long after they end, with their images "
+                   "and the bundles no other job uses (e.g. 7d, 12h, 30m, 90s; 0: keep them)")
+        ->capture_default_str();
+    // Hidden: `vrl render --workers` names its temporary folder, removed when this process ends (also
+    // when the client was killed: the coordinator then gets SIGTERM from PR_SET_PDEATHSIG).
+    app.add_option("--remove-on-exit", removeOnExit, "")->group("");
     app.add_option("--log-level", logLevel, "trace, debug, info, warn, error")->capture_default_str()
         ->check(CLI::IsMember({"trace", "debug", "info", "warn", "error"}));
     try {
@@ -61,7 +72,19 @@ int coordinatorMain(int argc, char** argv) {
         const int code = app.exit(e);
         return code == 0 ? 0 : 2;
     }
+    try {
+        options.retention = util::parseDuration(retention);
+    } catch (const std::invalid_argument& e) {
+        std::fprintf(stderr, "vrl-coordinator: --retention: %s\n", e.what());
+        return 2;
+    }
     spdlog::set_level(spdlog::level::from_str(logLevel));
+    // Removes the --remove-on-exit folder however this function returns.
+    const std::unique_ptr<const std::string, void (*)(const std::string*)> cleanup(
+        removeOnExit.empty() ? nullptr : &removeOnExit, [](const std::string* path) {
+            std::error_code error;
+            std::filesystem::remove_all(*path, error);
+        });
     options.leaseTimeout = std::chrono::milliseconds(int64_t(leaseTimeout * 1000));
     options.heartbeatTimeout = std::chrono::milliseconds(int64_t(heartbeatTimeout * 1000));
     options.heartbeatInterval = std::max(std::chrono::milliseconds(10), options.heartbeatTimeout / 5);
@@ -71,8 +94,8 @@ int coordinatorMain(int argc, char** argv) {
 
     std::optional<tbb::global_control> threadLimit;
     if (threads > 0) threadLimit.emplace(tbb::global_control::max_allowed_parallelism, size_t(threads));
-    // A second signal does not cut the drain short: `vrl render --workers` sends
-    // SIGTERM after the terminal's SIGINT reached the whole process group.
+    // A second signal does not cut the drain short (the children of `vrl render --workers` run in a
+    // process group of their own and are stopped by their client's SIGTERM, or by PR_SET_PDEATHSIG).
     util::TerminationSignals signals(false);
     try {
         server.token = rpc::loadToken(tokenFile);

@@ -133,7 +133,8 @@ public:
     grpc::Status FetchImage(grpc::ServerContext* context, const v1::JobRef* request,
                             grpc::ServerWriter<v1::DataChunk>* writer) override {
         return guarded(context, token_, [&] {
-            const std::string blob = rpc::readFileText(c_.imageFile(request->job_id()).string());
+            const std::string blob = request->partial() ? c_.partialImage(request->job_id())
+                                                        : rpc::readFileText(c_.imageFile(request->job_id()).string());
             return streamBlob(context, blob, util::sha256Hex(blob), 0, writer);
         });
     }
@@ -149,6 +150,25 @@ public:
     grpc::Status ListJobs(grpc::ServerContext* context, const v1::ListJobsRequest*, v1::ListJobsReply* reply) override {
         return guarded(context, token_, [&] {
             for (auto& job : c_.listJobs()) *reply->add_jobs() = std::move(job);
+            return grpc::Status::OK;
+        });
+    }
+
+    grpc::Status PurgeJobs(grpc::ServerContext* context, const v1::PurgeJobsRequest* request,
+                           v1::PurgeJobsReply* reply) override {
+        return guarded(context, token_, [&]() -> grpc::Status {
+            if (request->older_than_ms() < 0)
+                return {grpc::StatusCode::INVALID_ARGUMENT, "older_than_ms must be >= 0"};
+            *reply = c_.purgeJobs(std::chrono::milliseconds(request->older_than_ms()));
+            return grpc::Status::OK;
+        });
+    }
+
+    grpc::Status GetServiceInfo(grpc::ServerContext* context, const v1::GetServiceInfoRequest*,
+                                v1::ServiceInfo* reply) override {
+        return guarded(context, token_, [&] {
+            *reply = c_.serviceInfo();
+            reply->set_token_required(!token_.empty());
             return grpc::Status::OK;
         });
     }

@@ -8,6 +8,11 @@ bool isTerminal(v1::JobState state) {
     return state == v1::JOB_STATE_DONE || state == v1::JOB_STATE_FAILED || state == v1::JOB_STATE_CANCELLED;
 }
 
+int64_t unixMillisecondsNow() {
+    return std::chrono::duration_cast<std::chrono::milliseconds>(std::chrono::system_clock::now().time_since_epoch())
+        .count();
+}
+
 v1::JobProgress progressOf(const Job& job) {
     v1::JobProgress p;
     p.set_job_id(job.id);
@@ -18,6 +23,9 @@ v1::JobProgress progressOf(const Job& job) {
     p.set_tiles_total(uint32_t(job.tiles.size()));
     p.set_tiles_done(job.doneCount);
     p.set_preparing_fraction(job.preparingFraction);
+    p.set_preparing_phase(job.preparingPhase);
+    p.set_submitted_unix_ms(job.submittedUnixMs);
+    p.set_finished_unix_ms(job.finishedUnixMs);
     double eta = -1.0;
     if (job.state == v1::JOB_STATE_RENDERING && job.doneCount > job.doneAtStart) {
         const double elapsed = secondsSince(job.renderStart);

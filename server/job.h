@@ -5,7 +5,8 @@
 // job is stored and never change (so preparation may read them without the lock).
 //
 // Lifecycle: QUEUED -> PREPARING -> RENDERING -> DONE, or FAILED / CANCELLED from
-// any state before DONE. Jobs are never erased, so a Job& stays valid.
+// any state before DONE. A finished job may be purged (Coordinator::purgeJobs):
+// only then is it erased, so a Job& of an unfinished job stays valid.
 #pragma once
 
 #include "render/image/image.h"
@@ -38,7 +39,10 @@ struct Job {
     v1::JobState state = v1::JOB_STATE_QUEUED;
     std::string message;
     uint64_t version = 0;  // bumped on every change that waitForChange reports
-    double preparingFraction = 0.0;
+    double preparingFraction = 0.0;  // of preparingPhase
+    std::string preparingPhase;
+    int64_t submittedUnixMs = 0;  // wall clock, persisted in record.pb
+    int64_t finishedUnixMs = 0;   // 0 while unfinished
     std::vector<std::pair<std::string, double>> phases;
     // Set once prepared:
     int width = 0, height = 0;
@@ -68,6 +72,9 @@ struct Job {
 };
 
 bool isTerminal(v1::JobState state);
+
+// Milliseconds since the Unix epoch, now (the times jobs record).
+int64_t unixMillisecondsNow();
 
 // The job as clients see it: state, tiles, ETA, each worker's share, phase times.
 v1::JobProgress progressOf(const Job& job);

@@ -55,6 +55,12 @@ void JobStore::loadState() {
         if (fs::exists(job->dir / "record.pb")) {
             v1::JobProgress record;
             if (record.ParseFromString(rpc::readFileText((job->dir / "record.pb").string()))) {
+                job->submittedUnixMs = record.submitted_unix_ms();
+                if (!isTerminal(record.state())) {  // written at submission: only its time counts
+                    loaded.push_back(std::move(job));
+                    continue;
+                }
+                job->finishedUnixMs = record.finished_unix_ms();
                 job->state = record.state();
                 job->message = record.message();
                 for (const auto& phase : record.phases()) job->phases.emplace_back(phase.phase(), phase.seconds());
@@ -117,6 +123,7 @@ fs::path JobStore::bundleDirectory(const std::string& sha256) const {
 std::unique_ptr<Job> JobStore::newJob(const v1::JobSpec& spec) const {
     auto job = std::make_unique<Job>();
     job->id = "job-" + util::randomHex(12);
+    job->submittedUnixMs = unixMillisecondsNow();
     job->spec = spec;
     job->dir = stateDir_ / "jobs" / job->id;
     return job;
@@ -203,6 +210,60 @@ void JobStore::writeRecord(const Job& job) {
     } catch (const std::exception& e) {
         spdlog::error("{}: cannot record its end: {}", job.id, e.what());
     }
+}
+
+namespace {
+
+uint64_t sizeOnDisk(const fs::path& path) {
+    std::error_code error;
+    if (fs::is_regular_file(path, error)) return fs::file_size(path, error);
+    uint64_t bytes = 0;
+    for (auto it = fs::recursive_directory_iterator(path, error); !error && it != fs::recursive_directory_iterator();
+         it.increment(error))
+        if (it->is_regular_file(error)) bytes += it->file_size(error);
+    return bytes;
+}
+
+uint64_t removeAll(const fs::path& path) {
+    const uint64_t bytes = sizeOnDisk(path);
+    std::error_code error;
+    fs::remove_all(path, error);
+    if (error) spdlog::warn("purge: cannot remove '{}': {}", path.string(), error.message());
+    return bytes;
+}
+
+}  // namespace
+
+uint64_t JobStore::purge(const std::vector<std::string>& ids, std::chrono::milliseconds orphanAge,
+                         uint32_t* bundlesRemoved) {
+    uint64_t freed = 0;
+    std::set<std::string> candidates;  // bundles of purged jobs
+    for (const auto& id : ids) {
+        const auto it = jobs_.find(id);
+        if (it == jobs_.end() || !isTerminal(it->second->state)) continue;
+        candidates.insert(it->second->spec.bundle_sha256());
+        freed += removeAll(it->second->dir);
+        jobs_.erase(it);
+    }
+    std::set<std::string> used;
+    for (const auto& [id, job] : jobs_) used.insert(job->spec.bundle_sha256());
+    // Bundles no job uses: those of purged jobs at once; others (uploaded, never submitted) once old enough,
+    // so that a bundle uploaded just before its job is submitted survives.
+    const auto oldest = fs::file_time_type::clock::now() - orphanAge;
+    std::error_code error;
+    for (const auto& entry : fs::directory_iterator(stateDir_ / "bundles", error)) {
+        const fs::path file = entry.path();
+        if (file.extension() != ".bundle") continue;
+        const std::string sha = file.stem().string();
+        if (used.count(sha)) continue;
+        std::error_code timeError;
+        const auto written = fs::last_write_time(file, timeError);
+        if (!candidates.count(sha) && (timeError || written > oldest)) continue;
+        freed += removeAll(file) + removeAll(bundleDirectory(sha));
+        assets_.erase(sha);
+        if (bundlesRemoved) ++*bundlesRemoved;
+    }
+    return freed;
 }
 
 // ------------------------------------------------------------------ assets

@@ -1,13 +1,15 @@
 // JobStore: the jobs and what of them lives on disk under the state directory:
 //   bundles/<sha>.bundle, bundles/<sha>/    uploaded scene bundles, and extracted
 //   jobs/<id>/spec.pb                       every job's spec, written at submission
-//   jobs/<id>/record.pb                     a finished job's JobProgress
+//   jobs/<id>/record.pb                     the job's JobProgress at submission (its submit time),
+//                                           then as it ended (state, finish time, phases)
 //   jobs/<id>/tiles.log                     checkpoint: the accepted tiles of an unfinished job
 //   jobs/<id>/image.exr                     a done job's image (tile_assembly.h writes it)
 // plus the blobs (bundle, lights) that workers fetch while a job renders.
 // On construction it reloads every job found there (loadState): finished ones
 // keep their record, the others are queued again and their checkpoint is
-// replayed when they are prepared.
+// replayed when they are prepared. purge() deletes finished jobs and the
+// bundles no remaining job uses (vrl-coordinator --retention, vrl jobs --purge).
 //
 // Not thread-safe by itself: the Coordinator calls it with its mutex held. The
 // methods under "on disk" use nothing but the state directory and the limits,
@@ -20,6 +22,7 @@
 #include "service/common/limits.h"
 #include "vrl/v1/vrl.pb.h"
 
+#include <chrono>
 #include <filesystem>
 #include <map>
 #include <memory>
@@ -59,7 +62,12 @@ public:
     void openCheckpoint(Job& job);  // appends from now on
     void appendCheckpoint(Job& job, const v1::TileResult& result);
     void closeCheckpoint(Job& job);  // and removes tiles.log: the job has ended
-    void writeRecord(const Job& job);  // record.pb: the job as it ended; a failure is logged only
+    void writeRecord(const Job& job);  // record.pb: the job as it is now; a failure is logged only
+    // Deletes the finished jobs `ids` (records, images, directories) and then every
+    // bundle that they used and no remaining job does, plus bundles no job uses
+    // that were uploaded longer than `orphanAge` ago. Returns the bytes freed and
+    // counts the bundles removed in `bundlesRemoved`.
+    uint64_t purge(const std::vector<std::string>& ids, std::chrono::milliseconds orphanAge, uint32_t* bundlesRemoved);
 
     // --- blobs workers fetch (lock held)
     void publishAsset(const std::string& sha256, std::shared_ptr<const std::string> blob);

@@ -2,7 +2,10 @@
 
 #include "render/core/timing.h"
 #include "render/image/exr_io.h"
+#include "render/image/partial_image.h"
 #include "render/render_metadata.h"
+#include "service/common/rpc_common.h"
+#include "util/random_id.h"
 #include "util/strings.h"
 
 #include <algorithm>
@@ -27,6 +30,25 @@ std::string camelCase(const std::string& phase) {
         upper = false;
     }
     return out;
+}
+
+// The EXR metadata record of a job's image (whole or partial).
+RenderRecord recordOf(const std::string& id, const v1::JobSpec& spec, const std::map<std::string, std::string>& notes,
+                      const RenderSettings& settings, const RenderStatistics& stats,
+                      const std::vector<std::pair<std::string, double>>& phases, size_t workers) {
+    RenderRecord record;
+    record.scene = spec.name();
+    record.defines.insert(spec.defines().begin(), spec.defines().end());
+    record.medium = spec.medium();
+    record.sceneNotes = notes;
+    record.settings = settings;
+    record.statistics = stats;
+    // Light tracing and the tree build are in `stats` (vrl.time.lightTracing, vrl.time.treeBuild): the
+    // progress phases that repeat them are not written a second time under other names.
+    for (const auto& [phase, seconds] : phases)
+        if (phase != kLightTracingPhase && phase != kLightTreePhase) record.phases.emplace_back(camelCase(phase), seconds);
+    record.run = {{"job", id}, {"workers", int32_t(workers)}};
+    return record;
 }
 
 }  // namespace
@@ -114,18 +136,8 @@ std::optional<std::string> writeJobImage(Job& job) {
     stats.boundExceeded = job.boundExceeded;
     stats.boundedEstimates = job.boundedEstimates;
     stats.seconds = secondsSince(job.renderStart);
-    RenderRecord record;
-    record.scene = job.spec.name();
-    record.defines.insert(job.spec.defines().begin(), job.spec.defines().end());
-    record.medium = job.spec.medium();
-    record.sceneNotes = job.sceneNotes;
-    record.settings = job.settings;
-    record.statistics = stats;
-    // Light tracing and the tree build are in `stats` (vrl.time.lightTracing, vrl.time.treeBuild): the
-    // progress phases that repeat them are not written a second time under other names.
-    for (const auto& [phase, seconds] : job.phases)
-        if (phase != kLightTracingPhase && phase != kLightTreePhase) record.phases.emplace_back(camelCase(phase), seconds);
-    record.run = {{"job", job.id}, {"workers", int32_t(job.workers.size())}};
+    const RenderRecord record =
+        recordOf(job.id, job.spec, job.sceneNotes, job.settings, stats, job.phases, job.workers.size());
     writeRenderMetadata(record, *job.camera, images.metadata);
     try {
         writeExr(job.dir / "image.exr", images);  // atomic: a temporary sibling, then a rename
@@ -134,6 +146,59 @@ std::optional<std::string> writeJobImage(Job& job) {
     }
     job.phases.emplace_back("render", secondsSince(job.renderStart));
     return std::nullopt;
+}
+
+}  // namespace vrl::server
+
+namespace vrl::server {
+
+PartialImageInput partialImageInput(const Job& job) {
+    PartialImageInput in;
+    in.id = job.id;
+    in.spec = job.spec;
+    in.width = job.width;
+    in.height = job.height;
+    in.tiles = job.tiles;
+    in.done = job.done;
+    in.doneCount = job.doneCount;
+    in.layers = job.layers;
+    in.layerNames = job.layerNames;
+    in.sceneNotes = job.sceneNotes;
+    in.settings = job.settings;
+    in.camera = job.camera;
+    in.statistics = job.renderStatistics;
+    in.statistics.boundExceeded = job.boundExceeded;
+    in.statistics.boundedEstimates = job.boundedEstimates;
+    in.statistics.seconds = secondsSince(job.renderStart);
+    in.phases = job.phases;
+    in.workers = job.workers.size();
+    return in;
+}
+
+std::string assemblePartialImage(PartialImageInput in, const std::filesystem::path& scratchDir) {
+    std::vector<uint8_t> covered(size_t(in.width) * size_t(in.height), 0);
+    for (size_t t = 0; t < in.tiles.size(); ++t) {
+        if (!in.done[t]) continue;
+        const TileRect& r = in.tiles[t];
+        for (int y = r.y0; y < r.y1; ++y)
+            std::fill_n(covered.begin() + ptrdiff_t(size_t(y) * size_t(in.width) + size_t(r.x0)), r.width(), uint8_t(1));
+    }
+    ImageSet images = assembleImageSet(std::move(in.layers), in.layerNames, &in.statistics);
+    const RenderRecord record =
+        recordOf(in.id, in.spec, in.sceneNotes, in.settings, in.statistics, in.phases, in.workers);
+    writeRenderMetadata(record, *in.camera, images.metadata);
+    markPartial(images, covered, int(in.doneCount), int(in.tiles.size()));
+    const std::filesystem::path file = scratchDir / ("partial-" + util::randomHex(8) + ".exr");
+    writeExr(file, images);
+    std::string bytes;
+    try {
+        bytes = rpc::readFileText(file.string());
+    } catch (...) {
+        std::filesystem::remove(file);
+        throw;
+    }
+    std::filesystem::remove(file);
+    return bytes;
 }
 
 }  // namespace vrl::server

@@ -2,7 +2,9 @@
 // a result against the job's tiling (seconds, position, bounds, layer names and
 // sizes, finite values) and copies its pixels into the job's layers;
 // writeJobImage assembles the finished image, writes its metadata (the one
-// writer, writeRenderMetadata) and the EXR at <job dir>/image.exr.
+// writer, writeRenderMetadata) and the EXR at <job dir>/image.exr;
+// assemblePartialImage does the same for a job still rendering, with its
+// unfinished pixels zero and a "coverage" layer (render/image/partial_image.h).
 //
 // Duplicate tiles: a tile takes its first valid result only; a later one is
 // refused as a duplicate (no fault of its sender) and never merged twice.
@@ -14,6 +16,7 @@
 #include "vrl/v1/vrl.pb.h"
 
 #include <cstdint>
+#include <filesystem>
 #include <optional>
 #include <string>
 
@@ -35,5 +38,27 @@ void creditWorker(Job& job, const std::string& workerName, const v1::TileResult&
 // the EXR (atomically) and records the "render" phase. Returns why the EXR could not
 // be written; nothing on success.
 std::optional<std::string> writeJobImage(Job& job);
+
+// A copy of what a partial image needs from a rendering job (taken under the lock).
+struct PartialImageInput {
+    std::string id;
+    v1::JobSpec spec;
+    int width = 0, height = 0;
+    std::vector<TileRect> tiles;
+    std::vector<uint8_t> done;
+    uint32_t doneCount = 0;
+    std::vector<Image> layers;
+    std::vector<std::string> layerNames;
+    std::map<std::string, std::string> sceneNotes;
+    RenderSettings settings;
+    std::optional<PerspectiveCamera> camera;
+    RenderStatistics statistics;
+    std::vector<std::pair<std::string, double>> phases;
+    size_t workers = 0;
+};
+PartialImageInput partialImageInput(const Job& job);
+// The finished tiles as EXR bytes: unfinished pixels 0, markPartial's coverage layer
+// and vrl.partial / vrl.tilesTotal. Writes through a temporary file in `scratchDir`.
+std::string assemblePartialImage(PartialImageInput input, const std::filesystem::path& scratchDir);
 
 }  // namespace vrl::server

@@ -34,6 +34,7 @@ public:
     v1::RegisterReply add(const v1::RegisterRequest& request);
 
     bool known(const std::string& workerId) const { return workers_.count(workerId) != 0; }
+    size_t count() const { return workers_.size(); }  // registered and not (yet) forgotten
     // FailedPrecondition for a worker not (or no longer) registered: it must register again.
     void requireKnown(const std::string& workerId) const;
     // Notes that the worker is alive; false if it is not registered.

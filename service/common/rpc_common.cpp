@@ -39,6 +39,11 @@ grpc::ChannelArguments channelArguments() {
     args.SetInt(GRPC_ARG_HTTP2_MAX_PINGS_WITHOUT_DATA, 0);
     args.SetMaxReceiveMessageSize(kMaxMessageBytes);
     args.SetMaxSendMessageSize(kMaxMessageBytes);
+    // A restarted coordinator is found again within seconds (gRPC's default backoff grows to 120 s),
+    // so that clients and workers retrying on their own schedule are not kept waiting by the channel's.
+    args.SetInt(GRPC_ARG_INITIAL_RECONNECT_BACKOFF_MS, 250);
+    args.SetInt(GRPC_ARG_MIN_RECONNECT_BACKOFF_MS, 250);
+    args.SetInt(GRPC_ARG_MAX_RECONNECT_BACKOFF_MS, 4000);
     return args;
 }
 

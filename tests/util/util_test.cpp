@@ -3,6 +3,7 @@
 // file and no temporary behind) and their contracts (random ids' alphabet).
 #include "tests/support/temp_dir.h"
 #include "util/atomic_file.h"
+#include "util/duration.h"
 #include "util/hash.h"
 #include "util/random_id.h"
 #include "util/termination_signals.h"
@@ -19,6 +20,7 @@
 
 #include <pthread.h>
 
+#include <chrono>
 #include <filesystem>
 #include <fstream>
 #include <set>
@@ -165,3 +167,18 @@ TEST(UtilSignals, ExitWithParentIsANoOpOutsideLocalClusters) {
 
 }  // namespace
 }  // namespace vrl
+
+TEST(UtilDuration, ParsesUnitsAndRefusesTheRest) {
+    using namespace std::chrono_literals;
+    EXPECT_EQ(vrl::util::parseDuration("7d"), std::chrono::milliseconds(7 * 86400 * 1000LL));
+    EXPECT_EQ(vrl::util::parseDuration("12h"), std::chrono::milliseconds(12 * 3600 * 1000LL));
+    EXPECT_EQ(vrl::util::parseDuration("30m"), 30min);
+    EXPECT_EQ(vrl::util::parseDuration("90s"), 90s);
+    EXPECT_EQ(vrl::util::parseDuration("250ms"), 250ms);
+    EXPECT_EQ(vrl::util::parseDuration("0"), 0ms);
+    for (const char* bad : {"", "7", "d", "-1d", "1.5h", "7 d", "7w", "99999999999999d"})
+        EXPECT_THROW(vrl::util::parseDuration(bad), std::invalid_argument) << bad;
+    EXPECT_EQ(vrl::util::formatDuration(std::chrono::milliseconds(3 * 86400 * 1000LL + 4 * 3600 * 1000LL)), "3d 4h");
+    EXPECT_EQ(vrl::util::formatDuration(725s), "12m 5s");
+    EXPECT_EQ(vrl::util::formatDuration(7s), "7s");
+}
