@@ -313,6 +313,7 @@ int runRemoteRender(const RenderCommandOptions& o, const RemoteOptions& remote, 
         const ImageSet images = readExr(o.output);
         writePreviewPng(images.image, o.preview, autoExposure(images.image));
     }
+    if (o.quiet) return 0;  // -q: warnings and errors only
     std::fprintf(stderr, "summary: job %s, %u tiles, %.3f s in all -> %s\n", jobId.c_str(), last.tiles_total(),
                  secondsSince(start), o.output.c_str());
     for (const auto& phase : last.phases()) std::fprintf(stderr, "  %-18s %8.3f s\n", phase.phase().c_str(), phase.seconds());

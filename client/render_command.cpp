@@ -104,7 +104,11 @@ int runRender(const RenderCommandOptions& o, const CLI::App& command) {
     checkOutputPaths(o.output, o.preview, {o.scene});
     checkOutputPaths(o.output, o.preview, sceneInputFiles(o.scene, parseDefines(o.defines)));
     if (o.workers > 0) {
-        warnIneffectiveFlags(command, requestedMethod(o), true);
+        // The job is checked here (crop, resolution, method ...) with the builder the
+        // coordinator will use, so that bad input exits 2 before any process starts.
+        const RenderSettings settings = resolveLocally(o).settings;
+        warnIneffectiveFlags(command, settings.method, true);
+        checkLightMemory(settings, util::physicalMemoryBytes());
         return runLocalCluster(o);
     }
     using Clock = std::chrono::steady_clock;

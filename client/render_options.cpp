@@ -142,6 +142,12 @@ void checkLightMemory(const RenderSettings& settings, uint64_t memoryBytes) {
     throw std::invalid_argument(message);
 }
 
+rpc::ResolvedJob resolveLocally(const RenderCommandOptions& o) {
+    rpc::ServiceLimits limits;
+    limits.maxVrls = uint64_t(1) << 40;  // the memory check, not a coordinator's limit, bounds it here
+    return rpc::resolveJob(o.scene, makeJobSpec(o), limits);
+}
+
 std::map<std::string, std::string> parseDefines(const std::vector<std::string>& defines) {
     std::map<std::string, std::string> out;
     for (const auto& d : defines) {

@@ -3,6 +3,7 @@
 #pragma once
 
 #include "render/renderer.h"
+#include "service/job/job_scene.h"
 #include "vrl/v1/vrl.pb.h"
 
 #include <CLI/CLI.hpp>
@@ -58,6 +59,11 @@ void warnIneffectiveFlags(const CLI::App& command, RenderMethod method, bool dis
 // Throws std::invalid_argument, with the estimate, when the VRL set and light
 // tree of `settings` (estimateLightMemoryBytes) would not fit in `memoryBytes`.
 void checkLightMemory(const RenderSettings& settings, uint64_t memoryBytes);
+
+// The job of the flags resolved against the scene by the coordinator's own
+// builder (rpc::resolveJob, without a coordinator's limits): the method the scene
+// selects, and every JobSpecError (exit 2) before anything is started or sent.
+rpc::ResolvedJob resolveLocally(const RenderCommandOptions& o);
 
 // -D name=value list into a map; throws std::invalid_argument naming a bad entry.
 std::map<std::string, std::string> parseDefines(const std::vector<std::string>& defines);

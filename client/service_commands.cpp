@@ -2,6 +2,7 @@
 #include "client/commands.h"
 
 #include "client/job_client.h"
+#include "client/output_checks.h"
 #include "client/remote_render.h"
 #include "grpc/health/v1/health.grpc.pb.h"
 #include "render/scene/scene_error.h"
@@ -115,9 +116,14 @@ void registerServiceCommands(CLI::App& app, int& exitCode) {
             ->capture_default_str()->check(CLI::Range(0, 7 * 86400));
         auto noWorkerSeconds = std::make_shared<double>(15.0);
         cmd->add_option("--no-worker-warning", *noWorkerSeconds, "")->group("");  // hidden: tests use 1 s
-        cmd->callback([o, c, remote, retryFor, noWorkerSeconds, &exitCode] {
+        cmd->callback([o, c, remote, retryFor, noWorkerSeconds, cmd, &exitCode] {
             exitCode = guarded("submit", [&] {
                 if (o->quiet) spdlog::set_level(spdlog::level::warn);
+                if (remote->attachJob.empty() && !o->scene.empty()) {
+                    // Bad input exits 2 before connecting: outputs at once, then the job as the coordinator will build it.
+                    checkOutputPaths(o->output, o->preview, {o->scene});
+                    warnIneffectiveFlags(*cmd, resolveLocally(*o).settings.method, true);
+                }
                 remote->address = c->address;
                 remote->tls = c->tls;
                 remote->tokenFile = c->tokenFile;

@@ -461,11 +461,11 @@ int runReport(const Options& o) {
                     report.tableStats[run.method] = {stats.meanEvaluated, stats.meanIntersected};
                     for (const char* counter : {"eval", "inter"}) {
                         if (const Image* layer = layerOf(images, counter))
-                            lastOfMethod[std::string(methodName(run.method)) + "/" + counter] = ImageSet{*layer, {}, {}};
+                            lastOfMethod[std::string(methodName(run.method)) + "/" + counter] = ImageSet{*layer, {}, {}, {}};
                     }
                 }
                 if (run.method != RenderMethod::VrlLightcuts || run.errorThreshold == 0.02f) {
-                    lastOfMethod[std::string(methodName(run.method))] = ImageSet{images.image, {}, {}};
+                    lastOfMethod[std::string(methodName(run.method))] = ImageSet{images.image, {}, {}, {}};
                     lastLabel[std::string(methodName(run.method))] = run.label();
                 }
                 results.push_back(std::move(r));

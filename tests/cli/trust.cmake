@@ -68,3 +68,18 @@ add_test(NAME cli.coordinator_threads_zero_documented
 # Defaults: headline method, jitter, single-channel counters, VPL naming, quiet, stdout.
 add_test(NAME cli.defaults_and_streams
   COMMAND ${CMAKE_CURRENT_SOURCE_DIR}/cli/defaults_test.sh ${VRL_CLI} ${TRUST_SCENE} ${TRUST_DIR}/defaults)
+
+# The job is built locally by the coordinator's own builder before anything starts or is sent:
+# a crop outside the film is bad input (exit 2) for --workers and submit as for the embedded render.
+add_test(NAME cli.workers_bad_crop_refused_before_start
+  COMMAND ${CLI_CHECK} 2 "crop window 30,0,16,12.*does not fit inside the 40x30 film"
+          timeout 5 ${VRL_CLI} render ${TRUST_SCENE} -o ${TRUST_DIR}/crop.exr --resolution 40x30 --crop 30,0,16,12
+          --workers 2)
+add_test(NAME cli.submit_bad_crop_refused_before_connecting
+  COMMAND ${CLI_CHECK} 2 "crop window 30,0,16,12.*does not fit inside the 40x30 film"
+          timeout 5 ${VRL_CLI} submit ${TRUST_SCENE} -o ${TRUST_DIR}/crop.exr --resolution 40x30 --crop 30,0,16,12
+          --coordinator 127.0.0.1:9)
+add_test(NAME cli.submit_flag_without_effect_warns
+  COMMAND ${CLI_CHECK} 1 "--error has no effect with --method path.*UNAVAILABLE"
+          ${VRL_CLI} submit ${TRUST_SCENE} -o ${TRUST_DIR}/x.exr --method path --error 0.1 --coordinator 127.0.0.1:9
+          --retry-for 0)

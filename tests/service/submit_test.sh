@@ -9,7 +9,7 @@
 #    prints the commands to re-attach and cancel (exit 130), SIGTERM likewise (143);
 #  - --attach (no scene) survives a coordinator killed and restarted mid-job and
 #    writes the same image as an embedded render;
-#  - -q leaves only the summary; `vrl jobs` shows submit and finish times;
+#  - -q prints nothing on a clean run (warnings and errors only); `vrl jobs` shows submit and finish times;
 #    `vrl jobs --purge` deletes finished jobs and prints them.
 set -u
 vrl=$1 coordinator_bin=$2 worker_bin=$3 scene=$4
@@ -126,13 +126,13 @@ cancel=$(sed -n 's/^ *cancel: *vrl //p' "$work/term.err")
 "$vrl" $cancel | grep -q "$K: cancelled" || fail "the printed cancel command did not cancel: vrl $cancel"
 pass "SIGTERM: exit 143; 'vrl $cancel' cancelled the job"
 
-# 8. -q: warnings and errors only (and the summary); stdout empty.
+# 8. -q: warnings and errors only: nothing on a clean run; stdout empty.
 "$vrl" submit -q "$scene" --coordinator "$addr" -o "$work/q.exr" --method path --resolution 32x24 --spp 1 > "$work/q.out" 2> "$work/q.err" \
   || fail "submit -q failed"
 [ -s "$work/q.out" ] && fail "stdout of submit -q is not empty"
-grep -Eq "submitted|rendering|bundle" "$work/q.err" && fail "submit -q printed progress: $(cat "$work/q.err")"
-grep -q "^summary: job" "$work/q.err" || fail "no summary with -q"
-pass "-q: $(tr '\n' '|' < "$work/q.err")"
+[ -s "$work/q.err" ] && fail "submit -q printed: $(cat "$work/q.err")"
+[ -s "$work/q.exr" ] || fail "submit -q wrote no image"
+pass "-q: nothing printed, the image written"
 
 # 9. `vrl jobs` shows times; --purge deletes the finished jobs and says which.
 listing=$("$vrl" jobs --coordinator "$addr") || fail "vrl jobs"
