@@ -18,8 +18,9 @@ for signal in INT TERM; do
   "$vrl" render "$scene" -o "$out" "${flags[@]}" 2>"$work/$signal.log" &
   pid=$!
   sleep 3
-  # On a loaded machine the light tree may still be building at 3 s: wait for the rendering phase.
-  for _ in $(seq 100); do grep -q "^rendering" "$work/$signal.log" && break; sleep 0.2; done
+  # On a loaded machine (or under sanitizers) the light tree may still be building at 3 s:
+  # wait for the rendering phase (at most 60 s more).
+  for _ in $(seq 300); do grep -q "^rendering" "$work/$signal.log" && break; sleep 0.2; done
   kill -"$signal" "$pid"
   wait "$pid"; code=$?
   cat "$work/$signal.log"
@@ -43,7 +44,7 @@ out="$work/twice.exr"
 "$vrl" render "$scene" -o "$out" "${flags[@]}" --spp 1024 2>"$work/twice.log" &
 pid=$!
 sleep 3
-for _ in $(seq 100); do grep -q "^rendering" "$work/twice.log" && break; sleep 0.2; done
+for _ in $(seq 300); do grep -q "^rendering" "$work/twice.log" && break; sleep 0.2; done
 kill -INT "$pid"; sleep 0.2; kill -INT "$pid"
 start=$(date +%s%N)
 wait "$pid"; code=$?
