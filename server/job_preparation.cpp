@@ -7,6 +7,7 @@
 #include "service/job/job_scene.h"
 #include "service/job/scene_bundle.h"
 #include "util/hash.h"
+#include "util/system_memory.h"
 
 namespace vrl::server {
 
@@ -36,6 +37,13 @@ PreparedJob JobPreparation::prepare(const Job& job, const ProgressCallback& prog
     auto t0 = Clock::now();
     rpc::JobScene scene = rpc::loadJobScene(directory, directory / bundle.scene_path(), job.spec, limits_);
     phases.emplace_back("load scene", secondsSince(t0));
+    // Work that cannot fit is refused before light tracing starts: the lights' estimated memory against this machine's.
+    const uint64_t need = estimateLightMemoryBytes(scene.settings), have = util::physicalMemoryBytes();
+    if (have > 0 && need > have)
+        throw rpc::JobSpecError("the " + std::to_string(scene.settings.vrlCount) +
+                                (usesVpls(scene.settings.method) ? " VPLs" : " VRLs") + " and their light structures need about " +
+                                std::to_string(need >> 30) + " GiB, more than the coordinator's " +
+                                std::to_string(have >> 30) + " GiB of memory; ask for fewer --vrls");
     prepared.sceneNotes = sceneNotes(scene.scene->description());
     RenderStatistics& statistics = prepared.statistics;
     t0 = Clock::now();
