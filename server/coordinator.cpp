@@ -78,7 +78,9 @@ std::string Coordinator::submitJob(const v1::JobSpec& spec) {
         store_.add(std::move(job));
     }
     changed_.notify_all();
-    spdlog::info("{}: submitted ('{}', {}, priority {})", id, spec.name(), spec.parameters().method(), spec.priority());
+    spdlog::info("{}: submitted ('{}', {}, priority {})", id, spec.name(),
+                 spec.parameters().method().empty() ? "the scene's or the headline method" : spec.parameters().method(),
+                 spec.priority());
     return id;
 }
 
