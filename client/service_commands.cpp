@@ -69,7 +69,8 @@ std::string agoText(int64_t unixMs) {
     return util::formatDuration(now - std::chrono::milliseconds(unixMs));
 }
 
-// Runs body, mapping errors to exit codes: bad input 2, the rest 1.
+// Runs body, mapping errors to exit codes: bad input 2 (also what the
+// coordinator refuses as invalid or over its limits), the rest 1.
 template <class Body>
 int guarded(const char* command, Body&& body) {
     try {
@@ -82,7 +83,7 @@ int guarded(const char* command, Body&& body) {
         return 2;
     } catch (const JobClientError& e) {
         std::fprintf(stderr, "vrl %s: error: %s\n", command, e.what());
-        return e.code == grpc::StatusCode::INVALID_ARGUMENT ? 2 : 1;
+        return e.code == grpc::StatusCode::INVALID_ARGUMENT || e.code == grpc::StatusCode::RESOURCE_EXHAUSTED ? 2 : 1;
     } catch (const std::invalid_argument& e) {
         std::fprintf(stderr, "vrl %s: error: %s\n", command, e.what());
         return 2;
