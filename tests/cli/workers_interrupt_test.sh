@@ -22,6 +22,9 @@ left() { compgen -G "$TMPDIR/vrl-local-*" > /dev/null; }
 "$vrl" render "$scene" -o "$work/partial.exr" "${flags[@]}" > "$work/render.out" 2> "$work/render.err" &
 render=$!; pids+=("$render")
 sleep 3
+# On a loaded machine (or under sanitizers) the job may still be preparing at 3 s,
+# and there is nothing to keep yet: wait for the rendering phase (at most 60 s more).
+for _ in $(seq 300); do grep -q "^rendering" "$work/render.err" && break; sleep 0.2; done
 left || fail "no vrl-local-* folder while rendering (is TMPDIR honoured?)"
 kill -INT "$render"; wait "$render"; code=$?
 [ "$code" -eq 130 ] || fail "SIGINT: exit $code, expected 130"
