@@ -1,6 +1,6 @@
 #include "client/limits_check.h"
 
-#include "service/common/limits.h"
+#include "service/common/limits_proto.h"
 #include "service/common/rpc_common.h"
 #include "service/job/job_scene.h"
 
@@ -53,14 +53,7 @@ void checkAgainstLimits(const v1::ServiceInfo& info, uint64_t bundleBytes, size_
                                     std::to_string(l.max_pixels()) + nothingSent +
                                     "start vrl-coordinator with --max-pixels " + std::to_string(pixels) +
                                     " or more to accept it");
-    rpc::ServiceLimits limits;
-    limits.maxBundleBytes = l.max_bundle_bytes();
-    limits.maxBundleFiles = l.max_bundle_files();
-    limits.maxVrls = l.max_vrls();
-    limits.maxPixels = l.max_pixels();
-    limits.maxTileSize = l.max_tile_size();
-    limits.maxTiles = l.max_tiles();
-    limits.maxSamplesPerPixel = l.max_samples_per_pixel();
+    const rpc::ServiceLimits limits = rpc::fromProto(l);
     try {
         rpc::validateJobSpec(spec, limits);
     } catch (const rpc::JobSpecError& e) {

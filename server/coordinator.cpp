@@ -2,6 +2,7 @@
 
 #include "render/core/timing.h"
 #include "server/tile_assembly.h"
+#include "service/common/limits_proto.h"
 #include "service/common/rpc_common.h"
 #include "service/job/job_scene.h"
 #include "util/strings.h"
@@ -167,15 +168,7 @@ v1::ServiceInfo Coordinator::serviceInfo() const {
     v1::ServiceInfo info;
     info.set_program_version(VRL_VERSION);
     info.set_protocol_version(rpc::kProtocolVersion);
-    const rpc::ServiceLimits& l = options_.limits;
-    auto* limits = info.mutable_limits();
-    limits->set_max_bundle_bytes(l.maxBundleBytes);
-    limits->set_max_bundle_files(l.maxBundleFiles);
-    limits->set_max_vrls(l.maxVrls);
-    limits->set_max_pixels(l.maxPixels);
-    limits->set_max_tile_size(l.maxTileSize);
-    limits->set_max_tiles(l.maxTiles);
-    limits->set_max_samples_per_pixel(l.maxSamplesPerPixel);
+    *info.mutable_limits() = rpc::toProto(options_.limits);
     info.set_retention_ms(options_.retention.count());
     std::lock_guard lock(mutex_);
     info.set_workers_connected(uint32_t(workers_.count()));
