@@ -1,6 +1,6 @@
 #include "client/job_client.h"
 
-#include "render/scene_io/mitsuba/mitsuba_parser.h"
+#include "client/output_checks.h"
 #include "service/job/scene_bundle.h"
 #include "util/atomic_file.h"
 #include "util/hash.h"
@@ -202,11 +202,8 @@ v1::PurgeJobsReply JobClient::purge(std::chrono::milliseconds olderThan) {
 
 std::string collectSceneBundle(const std::filesystem::path& scene, const std::map<std::string, std::string>& defines,
                                std::vector<std::filesystem::path>* referenced) {
-    ParseOptions options;
-    options.defines = defines;
-    std::vector<std::filesystem::path> files;
-    options.onFileReferenced = [&](const std::filesystem::path& file) { files.push_back(file); };
-    (void)parseMitsubaScene(scene, options);  // also reports scene errors before anything is sent
+    // Parsing also reports scene errors (and unused -D) before anything is sent.
+    const std::vector<std::filesystem::path> files = sceneInputFiles(scene, defines);
     if (referenced) *referenced = files;
     return rpc::makeBundleBlob(scene, files);
 }

@@ -95,10 +95,6 @@ void addRenderOptions(CLI::App& cmd, RenderCommandOptions& o) {
     cmd.add_flag("-q,--quiet", o.quiet, "Warnings and errors only: no progress bars, no summary");
 }
 
-RenderMethod requestedMethod(const RenderCommandOptions& o) {
-    return o.method.empty() ? kHeadlineMethod : parseRenderMethod(o.method);
-}
-
 void warnIneffectiveFlags(const CLI::App& command, RenderMethod method, bool distributed) {
     const bool virtualLights = usesVirtualLights(method);
     const bool tree = usesLightTree(method);

@@ -47,10 +47,6 @@ struct RenderCommandOptions {
 // Registers the scene, output and every render flag on `cmd`.
 void addRenderOptions(CLI::App& cmd, RenderCommandOptions& o);
 
-// The method the flags ask for: --method, else the headline method (the scene's
-// <integrator> may still select another when the job is resolved).
-RenderMethod requestedMethod(const RenderCommandOptions& o);
-
 // Warns (spdlog, naming the flag and the method) about every flag given on
 // `command` that has no effect on `method` (e.g. --error with path; --tile-size
 // without --workers when `distributed` is false).
