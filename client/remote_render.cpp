@@ -184,12 +184,12 @@ private:
 std::string submitScene(JobClient& client, const RenderCommandOptions& o, const RemoteOptions& remote) {
     if (o.scene.empty())
         throw std::invalid_argument("give a scene file to submit, or --attach JOB to re-attach to a submitted job");
-    checkOutputPaths(o.output, o.preview, {o.scene});  // at once, before the scene is even parsed
     v1::JobSpec spec = makeJobSpec(o);
     spec.set_priority(remote.priority);
     std::vector<std::filesystem::path> inputs;
     const std::string blob = collectSceneBundle(o.scene, parseDefines(o.defines), &inputs);
     inputs.push_back(o.scene);
+    // The callers (vrl submit, render --workers) checked the outputs at once; now against every input too.
     checkOutputPaths(o.output, o.preview, inputs);
     checkAgainstLimits(client.serviceInfo(), blob.size(), inputs.size(), spec, remote.address);
     bool uploaded = false;
