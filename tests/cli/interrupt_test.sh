@@ -36,12 +36,13 @@ for signal in INT TERM; do
   grep -q "is a partial render" "$work/$signal.compare" || fail "vrl compare does not say $out is partial"
 done
 
-# A second Ctrl-C: exit 130 at once, nothing written. At 1024 spp a row of a
-# tile takes seconds, so the graceful stop of the first SIGINT is still waiting
-# for its rows when the second arrives 0.2 s later (signals sent back to back
-# would merge into one pending signal).
+# A second Ctrl-C: exit 130 at once, nothing written. At 65536 spp a row of a
+# tile takes about a minute on 2 cores (1024 spp took ~1 s on CI, too close to
+# the 0.2 s gap), so the graceful stop of the first SIGINT is still waiting for
+# its rows when the second arrives 0.2 s later (signals sent back to back would
+# merge into one pending signal).
 out="$work/twice.exr"
-"$vrl" render "$scene" -o "$out" "${flags[@]}" --spp 1024 2>"$work/twice.log" &
+"$vrl" render "$scene" -o "$out" "${flags[@]}" --spp 65536 2>"$work/twice.log" &
 pid=$!
 sleep 3
 for _ in $(seq 300); do grep -q "^rendering" "$work/twice.log" && break; sleep 0.2; done
