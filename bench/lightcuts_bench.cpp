@@ -48,7 +48,7 @@ Shading shade(const Scene& scene, const VrlSet& vrls, const LightTree* tree, flo
         for (int x = 0; x < camera.width(); x += stride) {
             Rng rng(seed, uint64_t(y) * camera.width() + x);
             CutStatistics stats;
-            out.image.at(x, y) = integrator.multipleScattering(camera.generateRay(x + 0.5f, y + 0.5f), rng, &stats);
+            out.image.at(x, y) = integrator.virtualLightParts(camera.generateRay(x + 0.5f, y + 0.5f), rng, &stats).multiple;
             evaluated += stats.evaluated, intersected += stats.intersected, cutSize += stats.cutSize;
         }
     });

@@ -17,7 +17,9 @@ namespace vrl {
 
 namespace {
 
+// Per-pixel cut counters: part (d)'s (the paper's Table 1), then part (c)'s.
 constexpr const char* kCutLayerNames[3] = {"eval", "inter", "cut"};
+constexpr const char* kSurfaceCutLayerNames[3] = {"medium-surface-eval", "medium-surface-inter", "medium-surface-cut"};
 
 // The ray of image pixel (x, y): through its film pixel, so a crop shades what the full film would.
 Ray cameraRay(const PerspectiveCamera& camera, const RenderSettings& settings, int x, int y, Rng& rng) {
@@ -27,6 +29,16 @@ Ray cameraRay(const PerspectiveCamera& camera, const RenderSettings& settings, i
 }
 
 bool isVrlMethod(const RenderSettings& settings) { return usesVirtualLights(settings.method); }
+
+// Part (c) comes from the VRLs (the VPL methods path-trace it).
+bool vrlLitSurfaces(const RenderSettings& settings) {
+    return isVrlMethod(settings) && !usesVpls(settings.method) && settings.transports.has(TransportPart::MediumSurface);
+}
+
+// The virtual lights are traced: part (d), or part (c) by VRLs, is selected.
+bool needsLights(const RenderSettings& settings) {
+    return isVrlMethod(settings) && (settings.transports.has(TransportPart::Multiple) || vrlLitSurfaces(settings));
+}
 
 }  // namespace
 
@@ -66,7 +78,7 @@ RenderLights prepareLights(const Scene& scene, const RenderSettings& settings, c
                            RenderStatistics* statistics) {
     validateRenderSettings(settings);
     RenderLights lights;
-    if (!isVrlMethod(settings) || !settings.transports.has(TransportPart::Multiple)) return lights;
+    if (!needsLights(settings)) return lights;
     RenderStatistics local;
     RenderStatistics& stats = statistics ? *statistics : local;
     LightTracingSettings tracing;
@@ -98,7 +110,7 @@ RenderLights prepareLights(const Scene& scene, const RenderSettings& settings, c
 }
 
 uint64_t estimateLightMemoryBytes(const RenderSettings& settings) {
-    if (!isVrlMethod(settings) || !settings.transports.has(TransportPart::Multiple) || settings.lightPaths > 0) return 0;
+    if (!needsLights(settings) || settings.lightPaths > 0) return 0;
     // The light tracer's vector may double while it is filled (2 lights per
     // light); a tree adds about 2 nodes per light plus its partitioning scratch
     // (about one more light).
@@ -123,8 +135,11 @@ std::vector<std::string> renderLayerNames(const RenderSettings& settings) {
     if (!isVrlMethod(settings)) return names;
     for (size_t p = 0; p < kTransportPartNames.size(); ++p)
         if (settings.transports.enabled[p]) names.emplace_back(kTransportPartNames[p]);
-    if (usesLightTree(settings.method))
+    if (usesLightTree(settings.method)) {
         for (const char* name : kCutLayerNames) names.emplace_back(name);
+        if (vrlLitSurfaces(settings))
+            for (const char* name : kSurfaceCutLayerNames) names.emplace_back(name);
+    }
     return names;
 }
 
@@ -197,12 +212,14 @@ TileImages TileShader::renderTile(const TileRect& tile, const RenderStop& stop) 
             std::array<Rgb, 4> parts{Rgb(0.0f), Rgb(0.0f), Rgb(0.0f), Rgb(0.0f)};
             for (int s = 0; s < settings_.samplesPerPixel; ++s) {
                 const auto sample = integrator_->samplePathParts(cameraRay(camera, settings_, x, y, rng), rng);
-                for (size_t p = 0; p < 3; ++p) parts[p] += sample[p];
+                for (size_t p = 0; p < 4; ++p) parts[p] += sample[p];
             }
-            for (size_t p = 0; p < 3; ++p) parts[p] /= spp;
-            // (d) once per pixel: its cost is per VRL, not per camera sample.
-            CutStatistics cut;
-            parts[3] = integrator_->multipleScattering(cameraRay(camera, settings_, x, y, rng), rng, &cut);
+            for (size_t p = 0; p < 4; ++p) parts[p] /= spp;
+            // (c) and (d) by VRLs once per pixel: their cost is per VRL, not per camera sample.
+            CutStatistics cut, surfaceCut;
+            const auto lit = integrator_->virtualLightParts(cameraRay(camera, settings_, x, y, rng), rng, &cut, &surfaceCut);
+            if (integrator_->vrlLitSurfaces()) parts[size_t(TransportPart::MediumSurface)] = lit.mediumSurface;
+            parts[size_t(TransportPart::Multiple)] = lit.multiple;
             Rgb sum(0.0f);
             size_t layer = 1;
             for (size_t p = 0; p < parts.size(); ++p) {
@@ -215,8 +232,13 @@ TileImages TileShader::renderTile(const TileRect& tile, const RenderStop& stop) 
                 out.layers[layer++].at(tx, ty) = Rgb(float(cut.evaluated));
                 out.layers[layer++].at(tx, ty) = Rgb(float(cut.intersected));
                 out.layers[layer++].at(tx, ty) = Rgb(float(cut.cutSize));
-                out.boundExceeded += cut.boundExceeded;
-                out.boundedEstimates += cut.boundedEstimates;
+                if (layer < out.layers.size()) {
+                    out.layers[layer++].at(tx, ty) = Rgb(float(surfaceCut.evaluated));
+                    out.layers[layer++].at(tx, ty) = Rgb(float(surfaceCut.intersected));
+                    out.layers[layer++].at(tx, ty) = Rgb(float(surfaceCut.cutSize));
+                }
+                out.boundExceeded += cut.boundExceeded + surfaceCut.boundExceeded;
+                out.boundedEstimates += cut.boundedEstimates + surfaceCut.boundedEstimates;
             }
         }
     }
@@ -237,9 +259,14 @@ ImageSet assembleImageSet(std::vector<Image> layers, const std::vector<std::stri
             if (name == kCutLayerNames[0]) statistics->meanEvaluated = mean;
             if (name == kCutLayerNames[1]) statistics->meanIntersected = mean;
             if (name == kCutLayerNames[2]) statistics->meanCutSize = mean;
+            if (name == kSurfaceCutLayerNames[0]) statistics->surfaceMeanEvaluated = mean;
+            if (name == kSurfaceCutLayerNames[1]) statistics->surfaceMeanIntersected = mean;
+            if (name == kSurfaceCutLayerNames[2]) statistics->surfaceMeanCutSize = mean;
         }
         result.layers.emplace_back(name, std::move(layers[l + 1]));
         for (const char* counter : kCutLayerNames)
+            if (name == counter) result.singleChannelLayers.insert(name);
+        for (const char* counter : kSurfaceCutLayerNames)
             if (name == counter) result.singleChannelLayers.insert(name);
     }
     return result;

@@ -28,8 +28,10 @@ namespace vrl {
 // job spec, code compares RenderMethod values, never strings).
 //   path: the volumetric path tracer (reference), one image
 //   vrl:  the four transport parts, multiple scattering by plain VRLs; one layer per part
-//   vrl-lightcuts: the same, multiple scattering by cuts through a VRL light tree,
-//         plus single-channel per-pixel layers "eval", "inter" and "cut" (statistics)
+//   vrl-lightcuts: the same, parts (c) and (d) by cuts through a VRL light tree,
+//         plus single-channel per-pixel layers "eval", "inter" and "cut" (statistics
+//         of (d)'s cuts) and, with part (c) selected, "medium-surface-eval",
+//         "medium-surface-inter", "medium-surface-cut" (those of (c)'s cuts)
 //   vpl:  the four parts, multiple scattering by plain VPLs (every VPL at each of
 //         the distance samples; the brute force VPL Lightcuts is measured against)
 //   vpl-lightcuts: the same layers as vrl-lightcuts, multiple scattering by VPL
@@ -88,8 +90,9 @@ struct RenderStatistics {
     // vrl-lightcuts method
     double treeSeconds = 0.0;
     size_t treeBytes = 0;
-    double meanEvaluated = 0.0, meanIntersected = 0.0, meanCutSize = 0.0;  // per pixel
-    uint64_t boundExceeded = 0, boundedEstimates = 0;  // inner-node estimates above their bound
+    double meanEvaluated = 0.0, meanIntersected = 0.0, meanCutSize = 0.0;  // per pixel, part (d)
+    double surfaceMeanEvaluated = 0.0, surfaceMeanIntersected = 0.0, surfaceMeanCutSize = 0.0;  // part (c)
+    uint64_t boundExceeded = 0, boundedEstimates = 0;  // inner-node estimates above their bound, (c) and (d)
 };
 
 // Called from worker threads with the fraction done of a phase ("light tracing",
@@ -102,7 +105,7 @@ void validateRenderSettings(const RenderSettings& settings);
 
 // The per-image light work of a render (the coordinator's part in the service):
 // the VRLs of the `vrl` method, or the light tree of `vrl-lightcuts` (which owns
-// its VRLs). Empty for the path tracer and when part (d) is not selected.
+// its VRLs). Empty for the path tracer and when neither part (c) nor (d) is selected.
 struct RenderLights {
     VrlSet vrls;
     LightTree tree;

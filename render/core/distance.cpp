@@ -70,4 +70,11 @@ double distancePointBox(const Vec3& point, const Imath::Box3f& box) {
     return std::sqrt(d2);
 }
 
+double distancePointSegment(const Vec3& point, const Vec3& a, const Vec3& b) {
+    const V3d ab = toDouble(b) - toDouble(a), ap = toDouble(point) - toDouble(a);
+    const double ll = ab.length2();
+    const double s = ll > 0.0 ? std::clamp(ap.dot(ab) / ll, 0.0, 1.0) : 0.0;
+    return (ap - ab * s).length();
+}
+
 }  // namespace vrl

@@ -18,5 +18,7 @@ double distanceLineBox(const Vec3& origin, const Vec3& direction, const Imath::B
 double distanceLineSegment(const Vec3& origin, const Vec3& direction, const Vec3& a, const Vec3& b);
 // Distance from a point to a box (0 inside it).
 double distancePointBox(const Vec3& point, const Imath::Box3f& box);
+// Distance from a point to the segment [a, b].
+double distancePointSegment(const Vec3& point, const Vec3& a, const Vec3& b);
 
 }  // namespace vrl

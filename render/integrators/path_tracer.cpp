@@ -41,19 +41,27 @@ Rgb VolumetricPathTracer::radiance(Ray ray, int medium, Rng& rng, const PathStar
     // (the camera ray itself, or the bounce before was a Dirac lobe).
     bool emissionCounts = start.emissionOnFirstHit && !restricted;
 
+    // After x1 (see PathStart::afterFirstSurface): the segment to x2 is crossed with
+    // exact transmittance (NotInMedium) or must scatter (InMedium); until x2.
+    using After = PathStart::AfterFirstSurface;
+    After afterX1 = After::Any;
+    bool pastX1 = false;
+
     float segmentStart = ray.tMin;  // where the ray entered its current medium
     int mediumBeforeCrossing = medium;  // before the last null boundary crossed
     for (int steps = 0; steps < 100000; ++steps) {
         const auto hit = scene_.intersect(ray);
         const float tSurface = hit ? hit->t : ray.tMax;
 
-        if (medium >= 0 && firstSegment && start.firstSegmentTransmittanceOnly) {
+        if (medium >= 0 && ((firstSegment && start.firstSegmentTransmittanceOnly) || afterX1 == After::NotInMedium)) {
             throughput *= scene_.media()[medium].transmittance(tSurface - segmentStart);
         } else if (medium >= 0) {
             const HomogeneousMedium& m = scene_.media()[medium];
             const FreeFlightSample flight = m.sampleFreeFlight(tSurface - segmentStart, rng.next(), rng.next());
             throughput *= flight.weight;
             if (flight.scattered) {
+                afterX1 = After::Any;  // x2 is this medium vertex
+                pastX1 = true;         // (or the first segment ended in the medium: no x1)
                 ++vertices;
                 firstSegment = false;
                 emissionCounts = false;
@@ -88,9 +96,13 @@ Rgb VolumetricPathTracer::radiance(Ray ray, int medium, Rng& rng, const PathStar
             Scene::continuePast(ray, *hit);  // same ray: distances stay exact
             continue;
         }
+        if (afterX1 == After::InMedium) break;  // x2 is a surface: not a path of this restriction
+        afterX1 = After::Any;
         const bool specularChain =
             firstSegment && start.throughSpecular && bsdf.isPurelySpecular() && vertices < kMaxSpecularChain;
-        if (!specularChain) firstSegment = false;
+        const bool atX1 = !specularChain && !pastX1;
+        if (!specularChain) firstSegment = false, pastX1 = true;
+        const bool onlyInMediumNext = atX1 && start.afterFirstSurface == After::InMedium;
         if (Scene::withinCrossing(ray, *hit)) medium = mediumBeforeCrossing;
         if (restricted && vertices + 1 <= 2) break;  // a surface among the first two vertices
 
@@ -98,7 +110,7 @@ Rgb VolumetricPathTracer::radiance(Ray ray, int medium, Rng& rng, const PathStar
         if (!mayScatterAgain()) break;
         const ShadingPoint sp = hit->shadingPoint();
         const Vec3 wo = -ray.direction;
-        if (!bsdf.isPurelySpecular()) {
+        if (!bsdf.isPurelySpecular() && !onlyInMediumNext) {
             const DirectLighting direct = sampleDirectLighting(scene_, hit->position, &*hit, medium, rng);
             if (counts() && !isBlack(direct.radianceOverPdf)) {
                 const Rgb f = bsdf.eval(sp, wo, direct.direction, TransportMode::Radiance);
@@ -107,8 +119,10 @@ Rgb VolumetricPathTracer::radiance(Ray ray, int medium, Rng& rng, const PathStar
         }
         const auto sampled = bsdf.sample(sp, wo, Vec2(rng.next(), rng.next()), rng.next(), TransportMode::Radiance);
         if (!sampled || isBlack(sampled->weight)) break;
+        if (atX1 && !sampled->delta) afterX1 = start.afterFirstSurface;
+        if (onlyInMediumNext && sampled->delta) break;
         throughput *= sampled->weight;
-        emissionCounts = sampled->delta && (!restricted || vertices >= 2);
+        emissionCounts = sampled->delta && (!restricted || vertices >= 2) && afterX1 != After::InMedium;
         medium = scene_.mediumAfter(*hit, sampled->wi, medium);
         ray = Ray{Scene::offsetOrigin(*hit, sampled->wi), sampled->wi};
         segmentStart = 0.0f;

@@ -33,6 +33,17 @@ struct PathStart {
     // The first segment continues through purely specular bounces (glass, mirrors):
     // the camera path of the VRL decomposition (camera_segment.h).
     bool throughSpecular = false;
+    // What may follow the surface vertex that ends the first segment (x1), when
+    // it leaves by a non-Dirac lobe: the split of surface light between part (a)
+    // and the VRL-lit part (c) (transport_parts.h).
+    //   Any: everything (the reference path tracer).
+    //   NotInMedium: the next segment is crossed with its exact transmittance,
+    //     no medium vertex on it (part (a): (c) has the paths whose x2 is in a medium).
+    //   InMedium: only paths whose next vertex x2 is a medium vertex count: no
+    //     emission or NEE at x1, a Dirac lobe or a segment that reaches a surface
+    //     unscattered ends the path (the reference for part (c) alone).
+    enum class AfterFirstSurface { Any, NotInMedium, InMedium };
+    AfterFirstSurface afterFirstSurface = AfterFirstSurface::Any;
 };
 
 class VolumetricPathTracer {

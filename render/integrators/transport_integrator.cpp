@@ -13,31 +13,37 @@ TransportIntegrator::TransportIntegrator(const Scene& scene, const VrlSet& vrls,
       settings_(settings),
       tracer_(scene, PathTracerSettings{settings.maxDepth}),
       estimator_(scene, settings.vrlSamples),
+      surfaceEstimator_(scene, settings.vrlSamples),
       tree_(tree) {
     if (settings.vpls && tree_)
         vplLightcuts_ = std::make_unique<VplLightcutsEstimator>(scene, *tree_, settings.cut, settings.vplDistanceSamples);
     else if (settings.vpls)
         plainVpls_ = std::make_unique<VplEstimator>(scene, vrls.vrls, settings.vplDistanceSamples);
-    else if (tree_)
+    else if (tree_) {
         lightcuts_ = std::make_unique<LightcutsEstimator>(scene, *tree_, estimator_, settings.cut);
+        surfaceLightcuts_ = std::make_unique<SurfaceLightcutsEstimator>(scene, *tree_, surfaceEstimator_, settings.cut);
+    }
     if (settings.maxDepth >= 0 && settings.maxDepth < 16 && scene.hasSpecularSurfaces() &&
-        settings.transports.has(TransportPart::Multiple))
-        spdlog::warn("maxDepth {} with specular surfaces: multiple scattering (d) seen through glass or mirrors "
-                     "does not count the specular bounces towards maxDepth", settings.maxDepth);
+        (settings.transports.has(TransportPart::Multiple) ||
+         (!settings.vpls && settings.transports.has(TransportPart::MediumSurface))))
+        spdlog::warn("maxDepth {} with specular surfaces: the VRL parts (c), (d) seen through glass or mirrors "
+                     "do not count the specular bounces towards maxDepth", settings.maxDepth);
 }
 
 std::array<Rgb, 4> TransportIntegrator::samplePathParts(const Ray& cameraRay, Rng& rng) const {
     std::array<Rgb, 4> parts{Rgb(0.0f), Rgb(0.0f), Rgb(0.0f), Rgb(0.0f)};
+    using After = PathStart::AfterFirstSurface;
     if (settings_.transports.has(TransportPart::Surface))
-        parts[size_t(TransportPart::Surface)] =
-            tracer_.radiance(cameraRay, scene_.cameraMedium(), rng, PathStart{0, true, true, true});
-    const bool single = settings_.transports.has(TransportPart::Single);
-    const bool mediumSurface = settings_.transports.has(TransportPart::MediumSurface);
-    if (!single && !mediumSurface) return parts;
+        parts[size_t(TransportPart::Surface)] = tracer_.radiance(cameraRay, scene_.cameraMedium(), rng,
+                                                                 PathStart{0, true, true, true, After::NotInMedium});
+    if (!vrlLitSurfaces() && settings_.transports.has(TransportPart::MediumSurface))
+        parts[size_t(TransportPart::MediumSurface)] = tracer_.radiance(
+            cameraRay, scene_.cameraMedium(), rng, PathStart{0, true, false, true, After::InMedium});
+    if (!settings_.transports.has(TransportPart::Single)) return parts;
     for (const CameraSegment& segment : cameraSegments(scene_, cameraRay, scene_.cameraMedium(), &rng, settings_.maxDepth)) {
         if (scene_.media()[segment.medium].isNonScattering()) continue;
-        if (single) parts[size_t(TransportPart::Single)] += singleScattering(segment, rng);
-        if (mediumSurface) parts[size_t(TransportPart::MediumSurface)] += mediumToSurface(segment, rng);
+        parts[size_t(TransportPart::Single)] += singleScattering(segment, rng);
+        parts[size_t(TransportPart::Single)] += mediumToSurface(segment, rng);
     }
     return parts;
 }
@@ -91,31 +97,54 @@ Rgb TransportIntegrator::mediumToSurface(const CameraSegment& segment, Rng& rng)
            float(1.0 / pdf);
 }
 
-Rgb TransportIntegrator::multipleScattering(const Ray& cameraRay, Rng& rng, CutStatistics* statistics) const {
-    Rgb sum(0.0f);
-    if (!settings_.transports.has(TransportPart::Multiple)) return sum;
+TransportIntegrator::VirtualLightParts TransportIntegrator::virtualLightParts(const Ray& cameraRay, Rng& rng,
+                                                                           CutStatistics* multipleStatistics,
+                                                                           CutStatistics* surfaceStatistics) const {
+    VirtualLightParts parts;
+    const bool multiple = settings_.transports.has(TransportPart::Multiple);
+    const bool surface = vrlLitSurfaces() && settings_.transports.has(TransportPart::MediumSurface);
+    if (!multiple && !surface) return parts;
     CutStatistics unused;
-    // One stream family per camera segment; VRL k draws from (key, k) in both plain
-    // and Lightcuts shading, so the two differ only by the cut's approximation.
+    // One stream family per camera segment (and one for the surface x1); VRL k draws
+    // from (key, k) in both plain and Lightcuts shading, so the two differ only by
+    // the cut's approximation.
     const uint64_t pixelKey = (uint64_t(rng.nextUint()) << 32) | rng.nextUint();
+    const CameraPath path = cameraPath(scene_, cameraRay, scene_.cameraMedium(), &rng, settings_.maxDepth);
+    if (surface && path.surface)
+        parts.mediumSurface = vrlLitSurface(*path.surface, Rng::combine(pixelKey, ~uint64_t(0)),
+                                            surfaceStatistics ? *surfaceStatistics : unused);
+    if (!multiple) return parts;
     uint64_t segmentIndex = 0;
-    for (const CameraSegment& segment : cameraSegments(scene_, cameraRay, scene_.cameraMedium(), &rng, settings_.maxDepth)) {
+    for (const CameraSegment& segment : path.segments) {
         const uint64_t streamKey = Rng::combine(pixelKey, segmentIndex++);
         if (scene_.media()[segment.medium].isNonScattering()) continue;
+        CutStatistics& statistics = multipleStatistics ? *multipleStatistics : unused;
         if (vplLightcuts_ || plainVpls_) {
             // The same distance samples in both: they differ only by the cut.
             Rng segmentRng = vrlStream(streamKey, ~0u);
-            sum += vplLightcuts_ ? vplLightcuts_->estimate(segment, segmentRng, statistics ? *statistics : unused)
-                                 : plainVpls_->estimate(segment, segmentRng);
+            parts.multiple += vplLightcuts_ ? vplLightcuts_->estimate(segment, segmentRng, statistics)
+                                            : plainVpls_->estimate(segment, segmentRng);
         } else if (lightcuts_) {
-            sum += lightcuts_->estimate(segment, streamKey, statistics ? *statistics : unused);
+            parts.multiple += lightcuts_->estimate(segment, streamKey, statistics);
         } else {
             const auto& vrls = tree_ ? tree_->vrls() : vrls_.vrls;
             for (uint32_t k = 0; k < vrls.size(); ++k) {
                 Rng vrlRng = vrlStream(streamKey, k);
-                sum += estimator_.contribution(vrls[k], segment, vrlRng);
+                parts.multiple += estimator_.contribution(vrls[k], segment, vrlRng);
             }
         }
+    }
+    return parts;
+}
+
+Rgb TransportIntegrator::vrlLitSurface(const CameraPathSurface& x, uint64_t streamKey, CutStatistics& statistics) const {
+    if (settings_.maxDepth >= 0 && settings_.maxDepth < x.specularBefore + 3) return Rgb(0.0f);
+    if (surfaceLightcuts_) return surfaceLightcuts_->estimate(x, streamKey, statistics);
+    Rgb sum(0.0f);
+    const auto& vrls = tree_ ? tree_->vrls() : vrls_.vrls;
+    for (uint32_t k = 0; k < vrls.size(); ++k) {
+        Rng vrlRng = vrlStream(streamKey, k);
+        sum += surfaceEstimator_.contribution(vrls[k], x, vrlRng);
     }
     return sum;
 }

@@ -1,31 +1,41 @@
 // render/integrators/: whole-image estimators: the reference volumetric path tracer
 // and the four-part transport integrator that the virtual-light methods share.
 //
-// TransportIntegrator: the image as the sum of four transport parts (transport_parts.h).
-// (a) path-traces from the first surface the camera ray reaches, with the
-// camera segment's exact transmittance; (b) samples a point on the camera
-// segment equiangularly towards a light and does next-event estimation there;
-// (c) samples a point on the segment in proportion to transmittance, a
-// direction by the phase function, and path-traces from the surface that
-// direction reaches (exact transmittance in between, no emission there: (b)
-// has it); (d) sums the VRL estimator over every VRL (plain VRLs, --method vrl),
-// walks Lightcuts over a VRL tree (vrl-lightcuts), or gathers VPLs at distance
-// samples, every one (vpl) or by Lightcuts over a VPL tree (vpl-lightcuts).
-// Each part is estimated for paths its siblings leave out, so the parts add up
-// to the reference path tracer's image. Camera paths continue through purely
-// specular surfaces (camera_segment.h): parts (b)-(d) shade every medium
-// segment of that path, and (a) takes the first other surface it reaches.
-// With a finite maxDepth, the specular bounces count towards it in (a)-(c); part
-// (d) does not know each VRL's depth and ignores them (a warning says so).
+// TransportIntegrator: the image as the sum of four transport parts
+// (transport_parts.h), split by the camera path's first two vertices x1, x2
+// (x1: the first vertex past null boundaries and, on the camera path of
+// camera_segment.h, past purely specular bounces):
+//   (a) x1 on a surface, x2 not in a medium: path-traced from x1, with the
+//       camera segment's exact transmittance and the segment after x1 crossed
+//       with its exact transmittance too (no medium vertex: (c) has those);
+//   (b) x1 in a medium, x2 not in a medium: single scattering from the lights
+//       (a point of the camera segment sampled equiangularly towards a light,
+//       next-event estimation there) plus light reflected by surfaces (a point
+//       sampled in proportion to transmittance, a direction by the phase
+//       function, path-traced from the surface it reaches, no emission there);
+//   (c) x1 on a surface, x2 in a medium: VRL-lit surfaces: every VRL
+//       (VrlSurfaceEstimator) or a cut through the VRL tree (surface_vrl_cut.h)
+//       at x1; the VPL methods path-trace it (their lights are points);
+//   (d) x1 and x2 in media: every VRL (--method vrl) or a cut (vrl-lightcuts)
+//       against each camera segment, or VPLs gathered at distance samples
+//       (vpl, vpl-lightcuts).
+// The four sets are disjoint and cover every path, so the parts add up to the
+// reference path tracer's image. Camera paths continue through purely specular
+// surfaces (camera_segment.h): parts (b)-(d) shade every medium segment of that
+// path, and (a), (c) take the first other surface it reaches. With a finite
+// maxDepth, the specular bounces count towards it in (a), (b); parts (c), (d)
+// do not know each VRL's depth and ignore them (a warning says so).
 #pragma once
 
 #include "render/integrators/path_tracer.h"
 #include "render/integrators/transport_parts.h"
 #include "render/lightcuts/light_tree.h"
 #include "render/lightcuts/vpl_cut.h"
+#include "render/lightcuts/surface_vrl_cut.h"
 #include "render/lightcuts/vrl_cut.h"
 #include "render/vrl/vrl.h"
 #include "render/vrl/vrl_estimator.h"
+#include "render/vrl/vrl_surface_estimator.h"
 
 #include <array>
 #include <memory>
@@ -44,26 +54,40 @@ struct TransportIntegratorSettings {
 
 class TransportIntegrator {
 public:
-    // Part (d) sums every VRL of `vrls`, or, when `tree` is given, walks Lightcuts over it.
+    // Parts (c), (d) sum every VRL of `vrls`, or, when `tree` is given, walk Lightcuts over it.
     TransportIntegrator(const Scene& scene, const VrlSet& vrls, const TransportIntegratorSettings& settings,
                   const LightTree* tree = nullptr);
 
-    // Parts (a), (b), (c) for one camera ray: one sample each.
+    // The path-sampled parts for one camera ray, one sample each: (a), (b), and
+    // for the VPL methods (c). The other entries are zero.
     std::array<Rgb, 4> samplePathParts(const Ray& cameraRay, Rng& rng) const;
-    // Part (d) for one camera ray: every VRL (or a cut) against every camera segment.
-    Rgb multipleScattering(const Ray& cameraRay, Rng& rng, CutStatistics* statistics = nullptr) const;
+
+    // The virtual-light parts for one camera ray: (c) at the surface the camera
+    // path reaches (VRL methods) and (d) along its medium segments, each from every
+    // light or a cut, with the cuts' counters.
+    struct VirtualLightParts {
+        Rgb mediumSurface{0.0f}, multiple{0.0f};
+    };
+    VirtualLightParts virtualLightParts(const Ray& cameraRay, Rng& rng, CutStatistics* multipleStatistics = nullptr,
+                                        CutStatistics* surfaceStatistics = nullptr) const;
+
+    // Part (c) is estimated from VRLs (not path-sampled).
+    bool vrlLitSurfaces() const { return !settings_.vpls; }
 
 private:
     Rgb singleScattering(const CameraSegment& segment, Rng& rng) const;
     Rgb mediumToSurface(const CameraSegment& segment, Rng& rng) const;
+    Rgb vrlLitSurface(const CameraPathSurface& x, uint64_t streamKey, CutStatistics& statistics) const;
 
     const Scene& scene_;
     const VrlSet& vrls_;
     TransportIntegratorSettings settings_;
     VolumetricPathTracer tracer_;
     VrlEstimator estimator_;
+    VrlSurfaceEstimator surfaceEstimator_;
     const LightTree* tree_;
     std::unique_ptr<LightcutsEstimator> lightcuts_;
+    std::unique_ptr<SurfaceLightcutsEstimator> surfaceLightcuts_;
     std::unique_ptr<VplLightcutsEstimator> vplLightcuts_;
     std::unique_ptr<VplEstimator> plainVpls_;
 };

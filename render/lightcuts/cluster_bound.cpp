@@ -16,35 +16,9 @@ constexpr double kRoundingMargin = 1.001;
 }  // namespace
 
 ClusterBound::ClusterBound(const Scene& scene, const LightTree& tree, ClusterBoundSettings settings)
-    : scene_(scene), tree_(tree), settings_(settings) {
+    : scene_(scene), tree_(tree), settings_(settings), leaves_(tree) {
     for (const auto& m : scene.media()) {
         for (int c = 0; c < 3; ++c) maxSigmaS_[c] = std::max(maxSigmaS_[c], m.sigmaS()[c]);
-    }
-    if (tree.empty()) return;
-    const auto& nodes = tree.nodes();
-    firstLeaf_.assign(nodes.size(), 0);
-    leafStart_.reserve(tree.vrls().size());
-    leafEnd_.reserve(tree.vrls().size());
-    // Post-order walk, left before right: leaves append their endpoints; an inner
-    // node's first leaf is its left child's.
-    std::vector<std::pair<int32_t, bool>> walk{{tree.root(), false}};
-    while (!walk.empty()) {
-        auto [i, visited] = walk.back();
-        walk.pop_back();
-        if (nodes[i].isLeaf()) {
-            const Vrl& v = tree.vrls()[nodes[i].representative];
-            firstLeaf_[i] = uint32_t(leafStart_.size());
-            leafStart_.push_back(v.origin);
-            leafEnd_.push_back(v.end());
-            continue;
-        }
-        if (!visited) {
-            walk.push_back({i, true});
-            walk.push_back({nodes[i].right, false});
-            walk.push_back({nodes[i].left, false});
-        } else {
-            firstLeaf_[i] = firstLeaf_[nodes[i].left];
-        }
     }
 }
 
@@ -54,9 +28,9 @@ double ClusterBound::minimumDistance(int32_t index, const CameraSegment& segment
         return distanceLineBox(segment.origin, segment.direction, node.box);
     // Small node: the exact distance from its VRL segments (a contiguous range).
     double best = std::numeric_limits<double>::infinity();
-    const uint32_t first = firstLeaf_[index];
-    for (uint32_t k = first; k < first + node.vrlCount; ++k)
-        best = std::min(best, distanceLineSegment(segment.origin, segment.direction, leafStart_[k], leafEnd_[k]));
+    const auto starts = leaves_.starts(index), ends = leaves_.ends(index);
+    for (size_t k = 0; k < starts.size(); ++k)
+        best = std::min(best, distanceLineSegment(segment.origin, segment.direction, starts[k], ends[k]));
     return best;
 }
 

@@ -24,6 +24,7 @@
 
 #include "render/core/distance.h"
 #include "render/lightcuts/cut_settings.h"
+#include "render/lightcuts/leaf_segments.h"
 #include "render/lightcuts/light_tree.h"
 #include "render/vrl/camera_segment.h"
 
@@ -49,10 +50,7 @@ private:
     const LightTree& tree_;
     ClusterBoundSettings settings_;
     Rgb maxSigmaS_{0.0f};  // over all media: for nodes spanning several
-    // VRL endpoints in depth-first leaf order, so that every node's VRLs are the
-    // contiguous range [firstLeaf_[node], firstLeaf_[node] + vrlCount).
-    std::vector<Vec3> leafStart_, leafEnd_;
-    std::vector<uint32_t> firstLeaf_;
+    LeafSegments leaves_;
 };
 
 }  // namespace vrl

@@ -10,6 +10,7 @@ namespace vrl {
 struct ClusterBoundSettings {
     uint32_t exactDistanceBelow = 32;  // VRL nodes with at most this many VRLs: h_min from their segments
     float anisotropyEpsilon = 1.0f;    // HG media: bound x (1 + epsilon)
+    float glossyMargin = 2.0f;         // VRL-lit glossy surfaces: f|cos| towards the box's corners x this
 };
 
 struct CutSettings {

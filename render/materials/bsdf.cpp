@@ -403,6 +403,12 @@ std::optional<BsdfSample> Bsdf::sample(const ShadingPoint& sp, const Vec3& wo, c
     return result;
 }
 
+std::optional<Rgb> Bsdf::lambertianBound(const Vec2& uv) const {
+    if (kind_ == Kind::Diffuse) return reflectance_.eval(uv) * kInvPi;
+    if (kind_ == Kind::Plastic) return plasticDiffuse(uv) * (kInvPi / (eta_ * eta_));
+    return std::nullopt;
+}
+
 Rgb Bsdf::albedo(const Vec2& uv) const {
     switch (kind_) {
     case Kind::Null:

@@ -66,6 +66,11 @@ public:
     // u: two uniforms for the direction, uLobe: one for the choice of lobe.
     std::optional<BsdfSample> sample(const ShadingPoint& sp, const Vec3& wo, const Vec2& u, float uLobe,
                                      TransportMode mode) const;
+    // A bound on f(wo, wi) (without the cosine) over every wi, for models whose
+    // non-Dirac part is Lambertian: diffuse (rho/pi, exact) and smooth plastic
+    // (its diffuse base through the coating, (1 - F) <= 1). Empty for the others
+    // (glossy lobes, purely specular and null models).
+    std::optional<Rgb> lambertianBound(const Vec2& uv) const;
     // Hemispherical reflectance estimate (for previews and light-tree weights): the
     // diffuse colour, or the specular colour for metals and glass.
     Rgb albedo(const Vec2& uv) const;

@@ -7,7 +7,13 @@ namespace vrl {
 
 std::vector<CameraSegment> cameraSegments(const Scene& scene, const Ray& cameraRay, int medium, Rng* rng,
                                           int maxDepth) {
-    std::vector<CameraSegment> segments;
+    return cameraPath(scene, cameraRay, medium, rng, maxDepth).segments;
+}
+
+CameraPath cameraPath(const Scene& scene, const Ray& cameraRay, int medium, Rng* rng, int maxDepth) {
+    CameraPath path;
+    std::vector<CameraSegment>& segments = path.segments;
+    int mediumBeforeCrossing = medium;  // before the last null boundary crossed
     Ray ray = cameraRay;
     Rgb throughput(1.0f);
     int specular = 0;
@@ -23,6 +29,7 @@ std::vector<CameraSegment> cameraSegments(const Scene& scene, const Ray& cameraR
         if (!hit) break;
         const Bsdf& bsdf = scene.shapes()[hit->shape].bsdf;
         if (bsdf.isNull()) {
+            if (!Scene::withinCrossing(ray, *hit)) mediumBeforeCrossing = medium;
             medium = scene.mediumAfter(*hit, ray.direction, medium);
             segmentStart = hit->t;
             Scene::continuePast(ray, *hit);
@@ -30,7 +37,13 @@ std::vector<CameraSegment> cameraSegments(const Scene& scene, const Ray& cameraR
         }
         // A specular bounce is a path vertex: after it, a medium vertex on the next
         // segment and a light still need to fit (specular + 1 + 2 segments).
-        if (!rng || !bsdf.isPurelySpecular() || specular >= kMaxSpecularChain) break;
+        if (!bsdf.isPurelySpecular()) {
+            // A surface flush with the boundary just crossed is met from the medium before it.
+            const int arrival = Scene::withinCrossing(ray, *hit) ? mediumBeforeCrossing : medium;
+            path.surface = CameraPathSurface{*hit, -ray.direction, arrival, throughput, specular};
+            break;
+        }
+        if (!rng || specular >= kMaxSpecularChain) break;
         if (maxDepth >= 0 && specular + 3 > maxDepth) break;
         const auto sampled = bsdf.sample(hit->shadingPoint(), -ray.direction, Vec2(rng->next(), rng->next()),
                                          rng->next(), TransportMode::Radiance);
@@ -41,7 +54,7 @@ std::vector<CameraSegment> cameraSegments(const Scene& scene, const Ray& cameraR
         ray = Ray{Scene::offsetOrigin(*hit, sampled->wi), sampled->wi};
         segmentStart = 0.0f;
     }
-    return segments;
+    return path;
 }
 
 }  // namespace vrl

@@ -14,12 +14,13 @@
 
 #include "render/core/geometry.h"
 #include "render/core/rgb.h"
+#include "render/scene/scene.h"
 
+#include <optional>
 #include <vector>
 
 namespace vrl {
 
-class Scene;
 class Rng;
 
 struct CameraSegment {
@@ -34,6 +35,22 @@ struct CameraSegment {
 // Most specular bounces a camera path follows before it ends (dropping the rest).
 inline constexpr int kMaxSpecularChain = 32;
 
+// Where a camera path ends on a surface that is neither null nor (when the walk
+// follows them) purely specular: the surface vertex x of part (c), VRL-lit
+// surfaces (transport_parts.h).
+struct CameraPathSurface {
+    SurfaceHit hit;
+    Vec3 wo;      // unit, from the surface back along the camera path
+    int medium = -1;  // the medium the path arrives in (on wo's side)
+    Rgb throughput{1.0f};  // transmittance and specular weights from the camera to the surface
+    int specularBefore = 0;
+};
+
+struct CameraPath {
+    std::vector<CameraSegment> segments;
+    std::optional<CameraPathSurface> surface;  // absent: the path escaped or was cut short
+};
+
 // Walks `ray` (starting in `medium`) through null boundaries and, when `rng` is
 // given, through purely specular surfaces (sampling one lobe each, at most
 // kMaxSpecularChain and stopping where maxDepth would), to the first other
@@ -41,5 +58,7 @@ inline constexpr int kMaxSpecularChain = 32;
 // Without `rng` the walk stops at the first non-null surface.
 std::vector<CameraSegment> cameraSegments(const Scene& scene, const Ray& ray, int medium, Rng* rng = nullptr,
                                           int maxDepth = -1);
+// The same walk (the same random numbers), with the surface it ends on.
+CameraPath cameraPath(const Scene& scene, const Ray& ray, int medium, Rng* rng = nullptr, int maxDepth = -1);
 
 }  // namespace vrl

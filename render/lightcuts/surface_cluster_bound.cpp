@@ -1,0 +1,105 @@
+#include "render/lightcuts/surface_cluster_bound.h"
+
+#include "render/core/distance.h"
+#include "render/scene/scene.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace vrl {
+
+namespace {
+
+constexpr double kRoundingMargin = 1.001;  // as cluster_bound.cpp
+
+// Largest value of the phase function over all angles.
+float phaseMaximum(const PhaseFunction& phase) {
+    if (phase.isIsotropic()) return float(kInv4Pi);
+    const double g = std::abs(double(phase.g()));
+    return float((1.0 + g) / (4.0 * M_PI * (1.0 - g) * (1.0 - g)));
+}
+
+// Largest and smallest of n.(p - x) over the box.
+std::pair<double, double> linearRange(const Imath::Box3f& box, const Vec3& n, const Vec3& x) {
+    double centre = 0.0, radius = 0.0;
+    for (int a = 0; a < 3; ++a) {
+        centre += double(n[a]) * (0.5 * (double(box.min[a]) + double(box.max[a])) - double(x[a]));
+        radius += std::abs(double(n[a])) * 0.5 * (double(box.max[a]) - double(box.min[a]));
+    }
+    return {centre - radius, centre + radius};
+}
+
+}  // namespace
+
+SurfaceClusterBound::SurfaceClusterBound(const Scene& scene, const LightTree& tree, ClusterBoundSettings settings)
+    : scene_(scene), tree_(tree), settings_(settings), leaves_(tree) {
+    for (const auto& m : scene.media()) {
+        for (int c = 0; c < 3; ++c) maxSigmaS_[c] = std::max(maxSigmaS_[c], m.sigmaS()[c]);
+        maxPhase_ = std::max(maxPhase_, phaseMaximum(m.phase()));
+    }
+}
+
+bool SurfaceClusterBound::provenFor(const Bsdf& bsdf) { return bsdf.lambertianBound(Vec2(0.0f, 0.0f)).has_value(); }
+
+double SurfaceClusterBound::minimumDistance(int32_t index, const Vec3& x) const {
+    const LightTreeNode& node = tree_.nodes()[index];
+    if (node.vrlCount > settings_.exactDistanceBelow) return distancePointBox(x, node.box);
+    double best = std::numeric_limits<double>::infinity();
+    const auto starts = leaves_.starts(index), ends = leaves_.ends(index);
+    for (size_t k = 0; k < starts.size(); ++k) best = std::min(best, distancePointSegment(x, starts[k], ends[k]));
+    return best;
+}
+
+Rgb SurfaceClusterBound::bound(int32_t index, const CameraPathSurface& x, bool* xInsideNode) const {
+    const LightTreeNode& node = tree_.nodes()[index];
+    const Vec3& p = x.hit.position;
+    const float reach = std::max({std::abs(node.box.min.x), std::abs(node.box.min.y), std::abs(node.box.min.z),
+                                  std::abs(node.box.max.x), std::abs(node.box.max.y), std::abs(node.box.max.z)});
+    const double slack = 8.0 * 0x1p-24 * (double(p.length()) + reach);
+    const double d = minimumDistance(index, p) - slack;
+    if (xInsideNode) *xInsideNode = !(d > 0.0);
+    if (!(d > 0.0)) return Rgb(std::numeric_limits<float>::infinity());
+
+    const SceneShape& shape = scene_.shapes()[x.hit.shape];
+    const Bsdf& bsdf = shape.bsdf;
+    // Reflection only on wo's geometric side: a box wholly behind gives nothing.
+    const bool reflectsOnly = bsdf.kind() != BsdfDescription::Kind::RoughDielectric;
+    const float side = x.wo.dot(x.hit.geometricNormal) >= 0.0f ? 1.0f : -1.0f;
+    if (reflectsOnly && linearRange(node.box, x.hit.geometricNormal * side, p).second < -slack) return Rgb(0.0f);
+
+    Rgb fCos;
+    if (const std::optional<Rgb> lambert = bsdf.lambertianBound(x.hit.uv)) {
+        const auto [lo, hi] = linearRange(node.box, x.hit.shadingNormal, p);
+        const double cosine = std::min(1.0, (std::max(std::abs(lo), std::abs(hi)) + slack) / d);
+        fCos = *lambert * float(cosine);
+    } else {
+        // Glossy: the largest f|cos| towards the box's corners and centre, with a margin (a heuristic).
+        const ShadingPoint sp = x.hit.shadingPoint();
+        Rgb largest(0.0f);
+        for (int corner = 0; corner < 9; ++corner) {
+            const Vec3 q = corner == 8 ? node.box.center()
+                                       : Vec3(corner & 1 ? node.box.max.x : node.box.min.x,
+                                              corner & 2 ? node.box.max.y : node.box.min.y,
+                                              corner & 4 ? node.box.max.z : node.box.min.z);
+            const Vec3 to = q - p;
+            const float length = to.length();
+            if (!(length > 0.0f)) continue;
+            const Rgb f = bsdf.eval(sp, x.wo, to / length, TransportMode::Radiance);
+            for (int c = 0; c < 3; ++c) largest[c] = std::max(largest[c], f[c]);
+        }
+        fCos = largest * settings_.glossyMargin;
+    }
+    if (isBlack(fCos)) return Rgb(0.0f);
+
+    const HomogeneousMedium* vrlMedium = node.medium >= 0 ? &scene_.media()[node.medium] : nullptr;
+    const Rgb sigmaS = vrlMedium ? vrlMedium->sigmaS() : maxSigmaS_;
+    const double phase = vrlMedium ? phaseMaximum(vrlMedium->phase()) : maxPhase_;
+    Rgb between(1.0f);
+    if (vrlMedium && node.medium == x.medium && reflectsOnly && !shape.changesMedium && vrlMedium->boundaryConvex())
+        between = vrlMedium->transmittance(float(d));
+    const double scale = kRoundingMargin * phase / (d * d);
+    return node.fluxLength * sigmaS * fCos * between * x.throughput * float(scale);
+}
+
+}  // namespace vrl

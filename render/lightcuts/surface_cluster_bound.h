@@ -1,0 +1,66 @@
+// SurfaceClusterBound: an upper bound on the single-sample part-(c) estimate
+// (VrlSurfaceEstimator, vrl/vrl_surface_estimator.h) of a light-tree node at a
+// surface point x, so that a cut can stop refining a node whose contribution is
+// below the error threshold. The paper bounds medium-to-medium nodes only
+// (cluster_bound.h); this is its counterpart for VRL-lit surfaces.
+//
+// Derivation. A node is estimated by its representative VRL (length L_rep)
+// carrying the cluster flux Phi_C. One sample of that VRL is
+//   Phi_C sigma_s f_p(d, -wi) [f_s(wo, wi) |cos(wi, n_s)|] T_r(v, x) V (theta_B - theta_A) / h
+// and (theta_B - theta_A) / h = integral_0^L dt / |x - v(t)|^2 <= L_rep / d^2,
+// d the distance from x to the representative's segment (the estimator floors
+// h from above, which only lowers the ratio). Each remaining factor is bounded
+// over every point p of the node's box B (the sampled v lies in B):
+//   - d >= dist(x, B), or the exact distance to the node's segments for small
+//     nodes (LeafSegments). x inside B (d = 0): no bound, the cut refines.
+//   - |cos(wi, n_s)| = |n_s.(v - x)| / |v - x| <= max_B |n_s.(p - x)| / d (<= 1);
+//     max_B of a linear function is at the box's support point.
+//   - f_s for a diffuse surface is rho(x)/pi whatever the directions (exact);
+//     a reflecting model is 0 for wi on the other geometric side than wo: if
+//     all of B lies there, the bound is 0.
+//   - f_p <= 1/(4 pi) (isotropic); Henyey-Greenstein: f_p <= (1 + |g|) / (4 pi (1 - |g|)^2),
+//     its value in the forward (g > 0) or backward peak, over every medium of a
+//     node spanning several. A proven bound, loose for strong g.
+//   - T_r(v, x) V <= T_r(d) when the node's VRLs lie in x's own medium and its
+//     boundary is convex (the segment x-v stays inside it), else 1.
+//   - sigma_s: the node's medium's, or the largest of all media.
+// With Phi_C L_rep = the node's flux x length:
+//   bound = fluxLength sigma_s f_p,max (rho/pi) cos_max T_r(d) throughput / d^2.
+// Glossy models (every non-diffuse kind with a non-Dirac lobe) have no such
+// bound here: theirs is glossyMargin times the largest f_s|cos| over the box's
+// corners and centre (a heuristic; CutStatistics::boundExceeded counts the
+// estimates above it). Float rounding of sample points: d is taken a few float
+// steps closer and the bound carries a 1.001 margin, as in cluster_bound.h.
+#pragma once
+
+#include "render/lightcuts/cut_settings.h"
+#include "render/lightcuts/leaf_segments.h"
+#include "render/lightcuts/light_tree.h"
+#include "render/vrl/camera_segment.h"
+
+namespace vrl {
+
+class Scene;
+
+class SurfaceClusterBound {
+public:
+    SurfaceClusterBound(const Scene& scene, const LightTree& tree, ClusterBoundSettings settings = {});
+
+    // RGB bound for `node` lighting `x`; +infinity (and *xInsideNode = true) when
+    // x lies in the node's box (or on one of a small node's segments).
+    Rgb bound(int32_t node, const CameraPathSurface& x, bool* xInsideNode = nullptr) const;
+    // The distance from x to the node used by the bound (box, or exact for small nodes).
+    double minimumDistance(int32_t node, const Vec3& x) const;
+    // Whether the bound is proven for the BSDF at x (diffuse) or a heuristic (glossy).
+    static bool provenFor(const Bsdf& bsdf);
+
+private:
+    const Scene& scene_;
+    const LightTree& tree_;
+    ClusterBoundSettings settings_;
+    Rgb maxSigmaS_{0.0f};   // over all media: for nodes spanning several
+    float maxPhase_ = 0.0f;  // largest phase-function value of any medium
+    LeafSegments leaves_;
+};
+
+}  // namespace vrl

@@ -1,0 +1,40 @@
+#include "render/lightcuts/surface_vrl_cut.h"
+
+#include "render/lightcuts/cut_walk.h"
+#include "render/lightcuts/vrl_cut.h"
+
+namespace vrl {
+
+SurfaceLightcutsEstimator::SurfaceLightcutsEstimator(const Scene& scene, const LightTree& tree,
+                                                     const VrlSurfaceEstimator& estimator, CutSettings settings)
+    : tree_(tree), estimator_(estimator), settings_(settings), bound_(scene, tree, settings.bound) {}
+
+Rgb SurfaceLightcutsEstimator::estimate(const CameraPathSurface& x, uint64_t streamKey,
+                                        CutStatistics& statistics) const {
+    if (tree_.empty()) return Rgb(0.0f);
+    struct Visitor {
+        const SurfaceLightcutsEstimator& self;
+        const CameraPathSurface& x;
+        uint64_t streamKey;
+        Rgb leaf(int32_t i) const {
+            const uint32_t k = self.tree_.nodes()[i].representative;
+            Rng rng = vrlStream(streamKey, k);
+            return self.estimator_.contribution(self.tree_.vrls()[k], x, rng);
+        }
+        bool bound(int32_t i, Rgb& b) const {
+            bool inside = false;
+            b = self.bound_.bound(i, x, &inside);
+            return !inside;
+        }
+        Rgb estimate(int32_t i) const {
+            const LightTreeNode& node = self.tree_.nodes()[i];
+            Vrl representative = self.tree_.vrls()[node.representative];
+            representative.flux = node.clusterFlux;
+            Rng rng = vrlStream(streamKey, node.representative);
+            return self.estimator_.contribution(representative, x, rng);
+        }
+    };
+    return walkCut(tree_, settings_, statistics, Visitor{*this, x, streamKey});
+}
+
+}  // namespace vrl

@@ -1,0 +1,35 @@
+// Lightcuts over VRLs for VRL-lit surfaces (part (c), transport_parts.h): for a
+// surface point x the camera sees, walk a cut through the same light tree as
+// part (d). Each node in the cut is estimated by its representative VRL with
+// the cluster flux Phi_C (VrlSurfaceEstimator); the node with the largest
+// SurfaceClusterBound is refined while that bound exceeds errorThreshold x
+// (luminance of the running total). A node whose box holds x has no bound and is
+// refined without being estimated (#Inter); leaves are single VRLs.
+#pragma once
+
+#include "render/lightcuts/cut_settings.h"
+#include "render/lightcuts/light_tree.h"
+#include "render/lightcuts/surface_cluster_bound.h"
+#include "render/vrl/vrl_surface_estimator.h"
+
+#include <cstdint>
+
+namespace vrl {
+
+class SurfaceLightcutsEstimator {
+public:
+    SurfaceLightcutsEstimator(const Scene& scene, const LightTree& tree, const VrlSurfaceEstimator& estimator,
+                              CutSettings settings);
+
+    // Part (c) at x from every VRL of the tree. VRL k draws from vrlStream(streamKey, k)
+    // as in plain VRL shading, so a cluster's estimate is its representative's plain sample rescaled.
+    Rgb estimate(const CameraPathSurface& x, uint64_t streamKey, CutStatistics& statistics) const;
+
+private:
+    const LightTree& tree_;
+    const VrlSurfaceEstimator& estimator_;
+    CutSettings settings_;
+    SurfaceClusterBound bound_;
+};
+
+}  // namespace vrl
