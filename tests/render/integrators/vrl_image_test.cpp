@@ -87,7 +87,8 @@ void expectAgree(const RunStatistics& vrl, const RunStatistics& reference, const
     EXPECT_LT(vrl.standardError[image][1], 0.05f * reference.mean[image][1]) << what << ": too noisy to mean much";
 }
 
-RunStatistics referenceRuns(const Scene& scene, int spp, bool onlyMediumToMedium, int maxDepth = -1) {
+RunStatistics referenceRuns(const Scene& scene, int spp, bool onlyMediumToMedium, int maxDepth = -1,
+                            const PathStart& start = {}) {
     return overRuns([&](uint64_t seed) {
         Image image(scene.camera().width(), scene.camera().height());
         const VolumetricPathTracer tracer(scene, PathTracerSettings{maxDepth, 5, onlyMediumToMedium});
@@ -96,7 +97,7 @@ RunStatistics referenceRuns(const Scene& scene, int spp, bool onlyMediumToMedium
                 Rng rng(seed * 7919, uint64_t(y * image.width() + x));
                 const Ray ray = scene.camera().generateRay(x + 0.5f, y + 0.5f);
                 Rgb sum(0.0f);
-                for (int s = 0; s < spp; ++s) sum += tracer.radiance(ray, scene.cameraMedium(), rng);
+                for (int s = 0; s < spp; ++s) sum += tracer.radiance(ray, scene.cameraMedium(), rng, start);
                 image.at(x, y) = sum / float(spp);
             }
         });
@@ -104,10 +105,11 @@ RunStatistics referenceRuns(const Scene& scene, int spp, bool onlyMediumToMedium
     });
 }
 
-RunStatistics vrlRuns(const Scene& scene, const std::string& transports, int spp, uint64_t vrls, int maxDepth = -1) {
+RunStatistics vrlRuns(const Scene& scene, const std::string& transports, int spp, uint64_t vrls, int maxDepth = -1,
+                      RenderMethod method = RenderMethod::Vrl) {
     return overRuns([&](uint64_t seed) {
         RenderSettings settings;
-        settings.method = RenderMethod::Vrl;
+        settings.method = method;
         settings.transports = TransportSelection::parse(transports);
         settings.samplesPerPixel = spp;
         settings.vrlCount = vrls;
@@ -155,6 +157,39 @@ TEST(VrlImage, PartsSumToReferenceInSharedVolCbox) {
     const auto scene = Scene::build(description);
     expectAgree(vrlRuns(*scene, "surface,single,medium-surface,multiple", 16, kVrls),
                 referenceRuns(*scene, kReferenceSpp, false), "vol_cbox");
+}
+
+// Part (c) alone, VRL-lit surfaces (plain VRLs and Lightcuts at the default 2%
+// threshold), equals the path tracer restricted to paths whose first camera
+// vertex is on a surface and whose second is in the medium.
+RunStatistics surfaceThenMediumReference(const Scene& scene) {
+    return referenceRuns(scene, kReferenceSpp, false, -1,
+                         PathStart{0, true, false, false, PathStart::AfterFirstSurface::InMedium});
+}
+
+TEST(VrlImage, MediumSurfaceEqualsRestrictedReference) {
+    for (const MediumCase& m : kMedia) {
+        const auto scene = Scene::build(test::litRoomWithOccluder(m.sigmaS * 0.5f, m.sigmaA * 0.5f, m.g));
+        const RunStatistics reference = surfaceThenMediumReference(*scene);
+        expectAgree(vrlRuns(*scene, "medium-surface", 1, kVrls), reference, m.name);
+        expectAgree(vrlRuns(*scene, "medium-surface", 1, kVrls, -1, RenderMethod::VrlLightcuts), reference,
+                    (std::string(m.name) + " lightcuts").c_str());
+    }
+}
+
+TEST(VrlImage, MediumSurfaceEqualsRestrictedReferenceInSharedVolCbox) {
+    const std::filesystem::path file = std::filesystem::path(VRL_SHARED_SCENES_DIR) / "lajolla-volpath-test/vol_cbox.xml";
+    if (!std::filesystem::exists(file)) GTEST_SKIP() << "shared scene " << file << " is absent";
+    SceneDescription description = parseMitsubaScene(file);
+    description.sensor.width = description.sensor.height = 16;
+    const auto scene = Scene::build(description);
+    const RunStatistics reference = surfaceThenMediumReference(*scene);
+    expectAgree(vrlRuns(*scene, "medium-surface", 1, kVrls), reference, "vol_cbox (c)");
+    expectAgree(vrlRuns(*scene, "medium-surface", 1, kVrls, -1, RenderMethod::VrlLightcuts), reference,
+                "vol_cbox (c) lightcuts");
+    // The whole four-part image with both parts (c) and (d) by Lightcuts.
+    expectAgree(vrlRuns(*scene, "surface,single,medium-surface,multiple", 16, kVrls, -1, RenderMethod::VrlLightcuts),
+                referenceRuns(*scene, kReferenceSpp, false), "vol_cbox lightcuts");
 }
 
 TEST(VrlImage, PartsSumToReferenceInLitRoomWithOccluder) {

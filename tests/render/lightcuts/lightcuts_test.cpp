@@ -1,5 +1,5 @@
 // Error control of VRL Lightcuts: over the same VRLs and seeds, the Lightcuts
-// image of part (d) differs from the plain-VRL image by a relative RMSE that
+// image of part (d), and that of part (c) (VRL-lit surfaces, its own bound), differs from the plain-VRL image by a relative RMSE that
 // shrinks with the error threshold and stays below the threshold itself (the
 // threshold bounds each refined node's error relative to the pixel's total, and
 // the errors of a cut's nodes partly cancel). Both methods draw VRL k's sample
@@ -18,10 +18,10 @@
 namespace vrl {
 namespace {
 
-RenderSettings multipleScattering(RenderMethod method, float error) {
+RenderSettings multipleScattering(RenderMethod method, float error, const char* part = "multiple") {
     RenderSettings settings;
     settings.method = method;
-    settings.transports = TransportSelection::parse("multiple");
+    settings.transports = TransportSelection::parse(part);
     settings.vrlCount = 6000;
     settings.seed = 3;
     settings.cut.errorThreshold = error;
@@ -29,19 +29,22 @@ RenderSettings multipleScattering(RenderMethod method, float error) {
     return settings;
 }
 
-void expectErrorControl(const Scene& scene, const char* name) {
-    const Image plain = render(scene, multipleScattering(RenderMethod::Vrl, 0.0f)).image;
+void expectErrorControl(const Scene& scene, const char* name, const char* part = "multiple") {
+    const Image plain = render(scene, multipleScattering(RenderMethod::Vrl, 0.0f, part)).image;
     double previous = 1e30;
     for (float error : {0.1f, 0.03f, 0.01f}) {
-        const ImageSet cut = render(scene, multipleScattering(RenderMethod::VrlLightcuts, error));
+        const ImageSet cut = render(scene, multipleScattering(RenderMethod::VrlLightcuts, error, part));
         const ImageErrorMetrics m = compareImages(plain, cut.image);
-        std::printf("%s: threshold %.3f -> relative RMSE %.5f against plain VRLs\n", name, error, m.relativeRmse);
-        EXPECT_LT(m.relativeRmse, error) << name << " threshold " << error;
-        EXPECT_LT(m.relativeRmse, previous) << name << ": error must shrink with the threshold";
+        std::printf("%s %s: threshold %.3f -> relative RMSE %.5f against plain VRLs\n", name, part, error,
+                    m.relativeRmse);
+        EXPECT_LT(m.relativeRmse, error) << name << " " << part << " threshold " << error;
+        EXPECT_LT(m.relativeRmse, previous) << name << " " << part << ": error must shrink with the threshold";
         previous = m.relativeRmse;
     }
-    const ImageSet exact = render(scene, multipleScattering(RenderMethod::VrlLightcuts, 0.0f));
-    EXPECT_LT(compareImages(plain, exact.image).relativeRmse, 1e-4) << name << ": threshold 0 refines to every VRL";
+    const ImageSet exact = render(scene, multipleScattering(RenderMethod::VrlLightcuts, 0.0f, part));
+    const double rmse = compareImages(plain, exact.image).relativeRmse;
+    std::printf("%s %s: threshold 0 -> relative RMSE %.2e against plain VRLs\n", name, part, rmse);
+    EXPECT_LT(rmse, 1e-4) << name << " " << part << ": threshold 0 refines to every VRL";
 }
 
 TEST(Lightcuts, ErrorShrinksWithThresholdOnDefaultScene) {
@@ -55,6 +58,44 @@ TEST(Lightcuts, ErrorShrinksWithThresholdOnDefaultScene) {
 TEST(Lightcuts, ErrorShrinksWithThresholdInLitRoom) {
     const auto scene = Scene::build(test::litRoomWithOccluder(Rgb(0.4f), Rgb(0.1f), 0.0f));
     expectErrorControl(*scene, "lit room");
+}
+
+TEST(Lightcuts, SurfaceErrorShrinksWithThresholdOnDefaultScene) {
+    SceneDescription d = parseMitsubaScene(std::filesystem::path(VRL_TEST_DATA_DIR) / "../scenes/smoke-room.xml");
+    d.sensor.width = 24;
+    d.sensor.height = 18;
+    const auto scene = Scene::build(d);
+    expectErrorControl(*scene, "smoke-room", "medium-surface");
+}
+
+TEST(Lightcuts, SurfaceErrorShrinksWithThresholdInLitRoom) {
+    const auto scene = Scene::build(test::litRoomWithOccluder(Rgb(0.4f), Rgb(0.1f), 0.0f));
+    expectErrorControl(*scene, "lit room", "medium-surface");
+}
+
+// Part (c)'s counters are their own layers, after part (d)'s.
+TEST(Lightcuts, SurfaceStatisticsLayers) {
+    const auto scene = Scene::build(test::litRoomWithOccluder(Rgb(0.4f), Rgb(0.1f), 0.0f));
+    RenderSettings settings = multipleScattering(RenderMethod::VrlLightcuts, 0.02f, "medium-surface,multiple");
+    RenderStatistics stats;
+    const ImageSet out = render(*scene, settings, {}, &stats);
+    const std::vector<std::string> names = {"medium-surface", "multiple", "eval", "inter", "cut",
+                                            "medium-surface-eval", "medium-surface-inter", "medium-surface-cut"};
+    ASSERT_EQ(out.layers.size(), names.size());
+    for (size_t i = 0; i < names.size(); ++i) EXPECT_EQ(out.layers[i].first, names[i]);
+    for (size_t i = 2; i < names.size(); ++i) EXPECT_TRUE(out.singleChannelLayers.count(names[i])) << names[i];
+    double eval = 0, cut = 0;
+    for (size_t i = 0; i < out.image.pixelCount(); ++i) {
+        eval += out.layers[5].second[i].x;
+        cut += out.layers[7].second[i].x;
+        EXPECT_GE(out.layers[5].second[i].x, out.layers[7].second[i].x);
+    }
+    const double n = double(out.image.pixelCount());
+    EXPECT_NEAR(stats.surfaceMeanEvaluated, eval / n, 1e-9 * eval);
+    EXPECT_NEAR(stats.surfaceMeanCutSize, cut / n, 1e-9 * cut);
+    EXPECT_GT(stats.surfaceMeanCutSize, 1.0);
+    EXPECT_LT(stats.surfaceMeanCutSize, double(stats.vrlCount)) << "a cut smaller than all VRLs is the point";
+    EXPECT_GT(stats.surfaceMeanIntersected, 0.0) << "VRLs end on the walls: some nodes hold the surface point";
 }
 
 TEST(Lightcuts, StatisticsLayersAndDeterminism) {
