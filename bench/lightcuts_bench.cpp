@@ -1,5 +1,6 @@
 // lightcuts_bench: VRL Lightcuts against plain VRLs on a scene (default: the
-// default scene), for several VRL counts. Prints, per N: light tracing time,
+// default scene), for several VRL counts, for part (d) (medium-to-medium, the
+// paper's) or, with --part medium-surface, part (c) (VRL-lit surfaces). Prints, per N: light tracing time,
 // hybrid tree build time and memory, the global agglomerative build's time and
 // the hybrid tree's extra gathering cost against it (N <= --global-max), and the
 // shading time of part (d) with plain VRLs and with Lightcuts at the error
@@ -32,10 +33,11 @@ struct Shading {
     CutStatistics total;
 };
 
-// Part (d) on every `stride`-th pixel in x and y (the others stay black).
-Shading shade(const Scene& scene, const VrlSet& vrls, const LightTree* tree, float error, int stride, uint64_t seed) {
+// Part (d) or (c) on every `stride`-th pixel in x and y (the others stay black).
+Shading shade(const Scene& scene, const VrlSet& vrls, const LightTree* tree, float error, int stride, uint64_t seed,
+              bool surfacePart) {
     TransportIntegratorSettings settings;
-    settings.transports = TransportSelection::parse("multiple");
+    settings.transports = TransportSelection::parse(surfacePart ? "medium-surface" : "multiple");
     settings.cut.errorThreshold = error;
     const TransportIntegrator integrator(scene, vrls, settings, tree);
     const PerspectiveCamera& camera = scene.camera();
@@ -48,7 +50,8 @@ Shading shade(const Scene& scene, const VrlSet& vrls, const LightTree* tree, flo
         for (int x = 0; x < camera.width(); x += stride) {
             Rng rng(seed, uint64_t(y) * camera.width() + x);
             CutStatistics stats;
-            out.image.at(x, y) = integrator.virtualLightParts(camera.generateRay(x + 0.5f, y + 0.5f), rng, &stats).multiple;
+            const auto parts = integrator.virtualLightParts(camera.generateRay(x + 0.5f, y + 0.5f), rng, &stats, &stats);
+            out.image.at(x, y) = surfacePart ? parts.mediumSurface : parts.multiple;
             evaluated += stats.evaluated, intersected += stats.intersected, cutSize += stats.cutSize;
         }
     });
@@ -60,7 +63,8 @@ Shading shade(const Scene& scene, const VrlSet& vrls, const LightTree* tree, flo
 }  // namespace
 
 int main(int argc, char** argv) {
-    CLI::App app{"VRL Lightcuts against plain VRLs (part (d) only)"};
+    CLI::App app{"VRL Lightcuts against plain VRLs (part (d), or part (c))"};
+    std::string part = "multiple";
     std::string scenePath = "scenes/smoke-room.xml";
     std::vector<uint64_t> counts = {10000, 100000, 1000000};
     std::string resolution = "64x48";
@@ -77,7 +81,10 @@ int main(int argc, char** argv) {
     app.add_option("--global-max", globalMax, "Largest N for the global agglomerative baseline (default 100000)");
     app.add_option("--stride-above", strideAbove, "Above this N, shade every --stride-th pixel in x and y (default 200000)");
     app.add_option("--stride", stride, "Pixel stride for large N (default 4: 1/16 of the pixels)");
+    app.add_option("--part", part, "Transport part: multiple (d, default) or medium-surface (c)")
+        ->check(CLI::IsMember({"multiple", "medium-surface"}));
     CLI11_PARSE(app, argc, argv);
+    const bool surfacePart = part == "medium-surface";
 
     ParseOptions parseOptions;
     for (const auto& d : defines) {
@@ -99,8 +106,8 @@ int main(int argc, char** argv) {
     const auto scene = Scene::build(description);
     std::string defined;
     for (const auto& d : defines) defined += " -D " + d;
-    std::printf("scene %s%s, %dx%d, error threshold %.3f, part (d) only\n", scenePath.c_str(), defined.c_str(), w, h,
-                error);
+    std::printf("scene %s%s, %dx%d, error threshold %.3f, part %s only\n", scenePath.c_str(), defined.c_str(), w, h,
+                error, surfacePart ? "(c) medium-to-surface" : "(d) medium-to-medium");
     std::printf("%9s %8s %9s %8s %9s %10s %9s %9s %8s %9s %8s %8s %8s\n", "VRLs", "trace_s", "build_s", "tree_MB",
                 "global_s", "gatherX", "plain_s", "cuts_s", "speedup", "relRMSE", "#Eval", "#Inter", "cut");
     for (uint64_t n : counts) {
@@ -115,14 +122,14 @@ int main(int argc, char** argv) {
         const double buildSeconds = secondsSince(start);
         const int s = n > strideAbove ? stride : 1;
         const double pixels = double((w + s - 1) / s) * ((h + s - 1) / s);
-        const Shading cuts = shade(*scene, vrls, &tree, error, s, 1);
-        const Shading plain = shade(*scene, vrls, nullptr, error, s, 1);
+        const Shading cuts = shade(*scene, vrls, &tree, error, s, 1, surfacePart);
+        const Shading plain = shade(*scene, vrls, nullptr, error, s, 1, surfacePart);
         std::string global = "-", gather = "-";
         if (n <= globalMax) {
             start = std::chrono::steady_clock::now();
             const LightTree globalTree = LightTree::build(vrls.vrls, LightTreeSettings{uint32_t(vrls.vrls.size()), 0});
             global = std::to_string(secondsSince(start)).substr(0, 7);
-            const Shading globalCuts = shade(*scene, vrls, &globalTree, error, s, 1);
+            const Shading globalCuts = shade(*scene, vrls, &globalTree, error, s, 1, surfacePart);
             gather = std::to_string(double(cuts.total.evaluated) / std::max(1u, globalCuts.total.evaluated)).substr(0, 5);
         }
         const ImageErrorMetrics m = compareImages(plain.image, cuts.image);

@@ -217,9 +217,14 @@ int runRender(const RenderCommandOptions& o, const CLI::App& command) {
         std::fprintf(stderr, "  transport parts: %s\n", settings.transports.toString().c_str());
     }
     if (usesLightTree(settings.method)) {
-        std::fprintf(stderr, "  light tree %.3f s, %.1f MiB; per pixel: #Eval %.1f, #Inter %.1f, cut size %.1f\n",
-                     stats.treeSeconds, double(stats.treeBytes) / (1024.0 * 1024.0), stats.meanEvaluated,
-                     stats.meanIntersected, stats.meanCutSize);
+        std::fprintf(stderr, "  light tree %.3f s, %.1f MiB\n", stats.treeSeconds,
+                     double(stats.treeBytes) / (1024.0 * 1024.0));
+        if (settings.transports.has(TransportPart::Multiple))
+            std::fprintf(stderr, "  per pixel, (d) medium-to-medium: #Eval %.1f, #Inter %.1f, cut size %.1f\n",
+                         stats.meanEvaluated, stats.meanIntersected, stats.meanCutSize);
+        if (settings.transports.has(TransportPart::MediumSurface) && !usesVpls(settings.method))
+            std::fprintf(stderr, "  per pixel, (c) medium-to-surface: #Eval %.1f, #Inter %.1f, cut size %.1f\n",
+                         stats.surfaceMeanEvaluated, stats.surfaceMeanIntersected, stats.surfaceMeanCutSize);
         std::fprintf(stderr, "  bound exceeded by %llu of %llu cluster estimates (%.4f%%)\n",
                      (unsigned long long)stats.boundExceeded, (unsigned long long)stats.boundedEstimates,
                      stats.boundedEstimates ? 100.0 * double(stats.boundExceeded) / double(stats.boundedEstimates) : 0.0);

@@ -45,6 +45,11 @@ void writeRenderMetadata(const RenderRecord& record, const PerspectiveCamera& ca
         metadata["vrl.meanEval"] = stats.meanEvaluated;
         metadata["vrl.meanInter"] = stats.meanIntersected;
         metadata["vrl.meanCut"] = stats.meanCutSize;
+        if (s.transports.has(TransportPart::MediumSurface) && !usesVpls(s.method)) {
+            metadata["vrl.surface.meanEval"] = stats.surfaceMeanEvaluated;
+            metadata["vrl.surface.meanInter"] = stats.surfaceMeanIntersected;
+            metadata["vrl.surface.meanCut"] = stats.surfaceMeanCutSize;
+        }
         metadata["vrl.boundExceeded"] = double(stats.boundExceeded);
         metadata["vrl.boundedEstimates"] = double(stats.boundedEstimates);
         metadata["vrl.time.treeBuild"] = stats.treeSeconds;

@@ -15,7 +15,8 @@
 //     vrl.vrls or vrl.vpls, vrl.lightPaths (double: counts beyond 2^31)
 //   Lightcuts: vrl.error, vrl.hgEpsilon (float); vrl.maxCut, vrl.exactDistanceBelow,
 //     vrl.partitionSize (int); vrl.meanEval, vrl.meanInter, vrl.meanCut,
-//     vrl.boundExceeded, vrl.boundedEstimates (double)
+//     vrl.boundExceeded, vrl.boundedEstimates (double); with part (c) by VRLs:
+//     vrl.surface.meanEval, vrl.surface.meanInter, vrl.surface.meanCut (double)
 //   VPL methods: vrl.vplDistanceSamples (int)
 //   vrl.time.<phase> (double seconds): lightTracing, treeBuild, render, and the caller's phases
 //   vrl.run.<name>: the caller's (threads, workers, job)
