@@ -23,7 +23,7 @@ DirectLighting sampleDirectLighting(const Scene& scene, const Vec3& point, const
     }
     const Rgb tr = scene.transmittance(origin, light.position, medium);
     if (isBlack(tr)) return {light.direction, Rgb(0.0f)};
-    return {light.direction, light.weight * tr / probability};
+    return {light.direction, light.weight * tr / probability, light.pdf * probability};
 }
 
 Rgb VolumetricPathTracer::radiance(Ray ray, int medium, Rng& rng, const PathStart& start) const {
@@ -37,9 +37,13 @@ Rgb VolumetricPathTracer::radiance(Ray ray, int medium, Rng& rng, const PathStar
     // Restriction to medium-medium prefixes: contributions count from the second vertex on.
     const bool restricted = settings_.onlyMediumToMedium;
     const auto counts = [&] { return !restricted || vertices >= 2; };
-    // An emitter hit at the end of the current segment is counted: NEE could not have found it
-    // (the camera ray itself, or the bounce before was a Dirac lobe).
+    // An emitter hit at the end of the current segment is counted: with weight 1 where NEE could
+    // not have found it (the camera ray itself, or the bounce before was a Dirac lobe); after a
+    // non-Dirac BSDF sample at a surface vertex (bsdfPdf > 0), with the power heuristic against
+    // NEE from that vertex (bsdfFrom), which counted the same path with the complementary weight.
     bool emissionCounts = start.emissionOnFirstHit && !restricted;
+    float bsdfPdf = 0.0f;
+    Vec3 bsdfFrom(0.0f);
 
     float segmentStart = ray.tMin;  // where the ray entered its current medium
     int mediumBeforeCrossing = medium;  // before the last null boundary crossed
@@ -77,8 +81,16 @@ Rgb VolumetricPathTracer::radiance(Ray ray, int medium, Rng& rng, const PathStar
         if (!hit || isBlack(throughput)) break;
 
         const SceneShape& shape = scene_.shapes()[hit->shape];
-        if (emissionCounts && shape.emitter >= 0)
-            result += throughput * scene_.emitters()[shape.emitter]->emittedRadiance(hit->geometricNormal, -ray.direction);
+        if (emissionCounts && shape.emitter >= 0) {
+            const Emitter& emitter = *scene_.emitters()[shape.emitter];
+            float weight = 1.0f;
+            if (bsdfPdf > 0.0f) {
+                const float lightPdf = scene_.emitterSampler().probability(size_t(shape.emitter)) *
+                                       emitter.pdfDirect(bsdfFrom, hit->position, hit->geometricNormal);
+                weight = powerHeuristic(bsdfPdf, lightPdf);
+            }
+            result += throughput * emitter.emittedRadiance(hit->geometricNormal, -ray.direction) * weight;
+        }
 
         const Bsdf& bsdf = shape.bsdf;
         if (bsdf.isNull()) {
@@ -102,13 +114,21 @@ Rgb VolumetricPathTracer::radiance(Ray ray, int medium, Rng& rng, const PathStar
             const DirectLighting direct = sampleDirectLighting(scene_, hit->position, &*hit, medium, rng);
             if (counts() && !isBlack(direct.radianceOverPdf)) {
                 const Rgb f = bsdf.eval(sp, wo, direct.direction, TransportMode::Radiance);
-                if (!isBlack(f)) result += throughput * direct.radianceOverPdf * f;
+                // An area light (pdf > 0) is also found by the BSDF sample below, which counts
+                // under the same condition (counts(), no medium collision on the way).
+                const float weight = settings_.surfaceMis && direct.pdf > 0.0f
+                                         ? powerHeuristic(direct.pdf, bsdf.pdf(sp, wo, direct.direction))
+                                         : 1.0f;
+                if (!isBlack(f)) result += throughput * direct.radianceOverPdf * f * weight;
             }
         }
         const auto sampled = bsdf.sample(sp, wo, Vec2(rng.next(), rng.next()), rng.next(), TransportMode::Radiance);
         if (!sampled || isBlack(sampled->weight)) break;
         throughput *= sampled->weight;
-        emissionCounts = sampled->delta && (!restricted || vertices >= 2);
+        const bool misEmission = settings_.surfaceMis && !sampled->delta;
+        emissionCounts = (sampled->delta || misEmission) && (!restricted || vertices >= 2);
+        bsdfPdf = misEmission ? sampled->pdf : 0.0f;
+        bsdfFrom = hit->position;
         medium = scene_.mediumAfter(*hit, sampled->wi, medium);
         ray = Ray{Scene::offsetOrigin(*hit, sampled->wi), sampled->wi};
         segmentStart = 0.0f;
