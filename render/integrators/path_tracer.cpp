@@ -23,8 +23,20 @@ DirectLighting sampleDirectLighting(const Scene& scene, const Vec3& point, const
     }
     const Rgb tr = scene.transmittance(origin, light.position, medium);
     if (isBlack(tr)) return {light.direction, Rgb(0.0f)};
-    return {light.direction, light.weight * tr / probability};
+    return {light.direction, light.weight * tr / probability, light.pdf * probability, tr};
 }
+
+namespace {
+
+// The BSDF strategy's density in the MIS weights is Bsdf::pdf times the chance
+// that its ray reaches the light unscattered: free-flight sampling (spectral
+// MIS) passes a stretch of transmittance T with probability average(T); a
+// stretch crossed by transmittance alone always passes. Both strategies take
+// it from the transmittance along their own ray to the same light point, so
+// the weights of a path sum to 1 (up to the offset of the shadow ray's ends).
+float passProbability(const Rgb& transmittance, bool surely) { return surely ? 1.0f : average(transmittance); }
+
+}  // namespace
 
 Rgb VolumetricPathTracer::radiance(Ray ray, int medium, Rng& rng, const PathStart& start) const {
     Rgb result(0.0f), throughput(1.0f);
@@ -37,9 +49,16 @@ Rgb VolumetricPathTracer::radiance(Ray ray, int medium, Rng& rng, const PathStar
     // Restriction to medium-medium prefixes: contributions count from the second vertex on.
     const bool restricted = settings_.onlyMediumToMedium;
     const auto counts = [&] { return !restricted || vertices >= 2; };
-    // An emitter hit at the end of the current segment is counted: NEE could not have found it
-    // (the camera ray itself, or the bounce before was a Dirac lobe).
+    // An emitter hit at the end of the current segment is counted: with weight 1 where NEE could
+    // not have found it (the camera ray itself, or the bounce before was a Dirac lobe); after a
+    // non-Dirac BSDF sample at a surface vertex (bsdfPdf > 0), with the power heuristic against
+    // NEE from that vertex (bsdfFrom), which counted the same path with the complementary weight.
     bool emissionCounts = start.emissionOnFirstHit && !restricted;
+    float bsdfPdf = 0.0f;
+    Vec3 bsdfFrom(0.0f);
+    // The BSDF ray's transmittance so far, and whether it crosses without sampling collisions.
+    Rgb bsdfTransmittance(1.0f);
+    bool bsdfPassesSurely = false;
 
     // After x1 (see PathStart::afterFirstSurface): the segment to x2 is crossed with
     // exact transmittance (NotInMedium) or must scatter (InMedium); until x2.
@@ -59,6 +78,7 @@ Rgb VolumetricPathTracer::radiance(Ray ray, int medium, Rng& rng, const PathStar
             const HomogeneousMedium& m = scene_.media()[medium];
             const FreeFlightSample flight = m.sampleFreeFlight(tSurface - segmentStart, rng.next(), rng.next());
             throughput *= flight.weight;
+            if (bsdfPdf > 0.0f && !flight.scattered) bsdfTransmittance *= m.transmittance(tSurface - segmentStart);
             if (flight.scattered) {
                 afterX1 = After::Any;  // x2 is this medium vertex
                 pastX1 = true;         // (or the first segment ended in the medium: no x1)
@@ -85,8 +105,16 @@ Rgb VolumetricPathTracer::radiance(Ray ray, int medium, Rng& rng, const PathStar
         if (!hit || isBlack(throughput)) break;
 
         const SceneShape& shape = scene_.shapes()[hit->shape];
-        if (emissionCounts && shape.emitter >= 0)
-            result += throughput * scene_.emitters()[shape.emitter]->emittedRadiance(hit->geometricNormal, -ray.direction);
+        if (emissionCounts && shape.emitter >= 0) {
+            const Emitter& emitter = *scene_.emitters()[shape.emitter];
+            float weight = 1.0f;
+            if (bsdfPdf > 0.0f) {
+                const float lightPdf = scene_.emitterSampler().probability(size_t(shape.emitter)) *
+                                       emitter.pdfDirect(bsdfFrom, hit->position, hit->geometricNormal);
+                weight = powerHeuristic(bsdfPdf * passProbability(bsdfTransmittance, bsdfPassesSurely), lightPdf);
+            }
+            result += throughput * emitter.emittedRadiance(hit->geometricNormal, -ray.direction) * weight;
+        }
 
         const Bsdf& bsdf = shape.bsdf;
         if (bsdf.isNull()) {
@@ -114,7 +142,15 @@ Rgb VolumetricPathTracer::radiance(Ray ray, int medium, Rng& rng, const PathStar
             const DirectLighting direct = sampleDirectLighting(scene_, hit->position, &*hit, medium, rng);
             if (counts() && !isBlack(direct.radianceOverPdf)) {
                 const Rgb f = bsdf.eval(sp, wo, direct.direction, TransportMode::Radiance);
-                if (!isBlack(f)) result += throughput * direct.radianceOverPdf * f;
+                // An area light (pdf > 0) is also found by the BSDF sample below, which counts
+                // under the same condition (counts(), no medium collision on the way).
+                const bool passesSurely = atX1 && start.afterFirstSurface == After::NotInMedium;
+                const float weight =
+                    settings_.surfaceMis && direct.pdf > 0.0f
+                        ? powerHeuristic(direct.pdf, bsdf.pdf(sp, wo, direct.direction) *
+                                                         passProbability(direct.transmittance, passesSurely))
+                        : 1.0f;
+                if (!isBlack(f)) result += throughput * direct.radianceOverPdf * f * weight;
             }
         }
         const auto sampled = bsdf.sample(sp, wo, Vec2(rng.next(), rng.next()), rng.next(), TransportMode::Radiance);
@@ -122,7 +158,13 @@ Rgb VolumetricPathTracer::radiance(Ray ray, int medium, Rng& rng, const PathStar
         if (atX1 && !sampled->delta) afterX1 = start.afterFirstSurface;
         if (onlyInMediumNext && sampled->delta) break;
         throughput *= sampled->weight;
-        emissionCounts = sampled->delta && (!restricted || vertices >= 2) && afterX1 != After::InMedium;
+        const bool misEmission = settings_.surfaceMis && !sampled->delta;
+        emissionCounts = (sampled->delta || misEmission) && (!restricted || vertices >= 2) && afterX1 != After::InMedium;
+        bsdfPdf = misEmission ? sampled->pdf : 0.0f;
+        bsdfFrom = hit->position;
+        // Part (a)'s x1 crosses the next segment by transmittance only: its BSDF ray always passes.
+        bsdfPassesSurely = afterX1 == After::NotInMedium;
+        bsdfTransmittance = Rgb(1.0f);
         medium = scene_.mediumAfter(*hit, sampled->wi, medium);
         ray = Ray{Scene::offsetOrigin(*hit, sampled->wi), sampled->wi};
         segmentStart = 0.0f;

@@ -100,8 +100,15 @@ public:
         const float dist = std::sqrt(dist2);
         const Vec3 dir = d / dist;
         const float cosLight = -dir.dot(n);
-        if (cosLight <= 0.0f) return {p, dir, dist, Rgb(0.0f)};
-        return {p, dir, dist, radiance_ * (cosLight * area_ / dist2)};  // pdf_area = 1/area
+        if (cosLight <= 0.0f) return {p, dir, dist, Rgb(0.0f), solidAnglePdf(dist2, cosLight)};
+        // pdf_area = 1/area, so weight = L / pdf = L cos area / d^2.
+        return {p, dir, dist, radiance_ * (cosLight * area_ / dist2), solidAnglePdf(dist2, cosLight)};
+    }
+    float pdfDirect(const Vec3& reference, const Vec3& position, const Vec3& normal) const override {
+        const Vec3 d = position - reference;
+        const float dist2 = d.length2();
+        if (!(dist2 > 0.0f)) return 0.0f;
+        return solidAnglePdf(dist2, d.dot(normal) / std::sqrt(dist2));
     }
     EmissionSample sampleEmission(const Vec2& uPosition, const Vec2& uDirection) const override {
         const auto [p, n] = samplePoint(uPosition);
@@ -110,6 +117,9 @@ public:
     }
 
 private:
+    // Uniform in area (1/area) converted to solid angle at distance^2 dist2 and cosine
+    // cosLight; +infinity at grazing incidence (MIS then gives that rare point to NEE alone).
+    float solidAnglePdf(float dist2, float cosLight) const { return dist2 / (std::abs(cosLight) * area_); }
     std::pair<Vec3, Vec3> samplePoint(const Vec2& u) const {
         const float target = u.x * area_;
         const size_t i = std::min(size_t(std::upper_bound(cdf_.begin(), cdf_.end(), target) - cdf_.begin()),

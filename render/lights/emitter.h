@@ -6,6 +6,10 @@
 // Area (uniform radiance from the front side of a triangle mesh).
 // Two sampling routines: sampleDirect for next-event estimation from a point,
 // sampleEmission for light tracing (a ray leaving the light, weighted by flux).
+// pdfDirect gives sampleDirect's density for a point found another way (a BSDF-
+// sampled ray that hit the light), so the two strategies can be weighted by
+// multiple importance sampling (Veach 1997 §9.2); point and spot lights are Dirac
+// (density 0 there: no other strategy finds them).
 #pragma once
 
 #include "render/core/geometry.h"
@@ -24,6 +28,7 @@ struct DirectLightSample {
     Vec3 direction{0.0f};  // unit, from the reference point to `position`
     float distance = 0; // |position - reference|
     Rgb weight{0.0f};   // incident radiance / pdf (solid angle), excluding transmittance and visibility
+    float pdf = 0.0f;   // that solid-angle pdf (= pdfDirect); 0 for a Dirac emitter (point, spot)
 };
 
 // A ray leaving an emitter for light tracing.
@@ -39,6 +44,12 @@ public:
     virtual Rgb power() const = 0;
     virtual DirectLightSample sampleDirect(const Vec3& reference, const Vec2& u) const = 0;
     virtual EmissionSample sampleEmission(const Vec2& uPosition, const Vec2& uDirection) const = 0;
+    // Solid-angle density (1/sr) with which sampleDirect(reference, .) picks `position`, a
+    // point of the emitter with geometric normal `normal`: pdf_area d^2 / |cos| (+infinity
+    // at grazing incidence, 0 where reference = position). 0 for Dirac emitters.
+    virtual float pdfDirect(const Vec3& /*reference*/, const Vec3& /*position*/, const Vec3& /*normal*/) const {
+        return 0.0f;
+    }
     // Radiance leaving an area emitter at a point with geometric normal n towards dirOut.
     virtual Rgb emittedRadiance(const Vec3& /*normal*/, const Vec3& /*dirOut*/) const { return Rgb(0.0f); }
     // The medium the emitter sits in (-1 = vacuum/unknown), for light tracing.

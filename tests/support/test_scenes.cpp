@@ -23,7 +23,7 @@ SensorDescription cameraAtOrigin(int width, int height, float fovDegrees) {
     return sensor;
 }
 
-SceneDescription emittingSphereFurnace(const Rgb& radiance, const Rgb& sigmaS, float g) {
+SceneDescription emittingSphereFurnace(const Rgb& radiance, const Rgb& sigmaS, float g, const Rgb& wallReflectance) {
     SceneDescription scene;
     scene.sensor = cameraAtOrigin(8, 8, 90.0f);
     scene.media.push_back(medium("furnace", sigmaS, Rgb(0.0f), g));
@@ -32,7 +32,7 @@ SceneDescription emittingSphereFurnace(const Rgb& radiance, const Rgb& sigmaS, f
     sphere.kind = ShapeDescription::Kind::Sphere;
     sphere.radius = 1.0f;
     sphere.flipNormals = true;  // emit towards the centre
-    sphere.bsdf = test::diffuseBsdf(Rgb(0.0f), false);
+    sphere.bsdf = test::diffuseBsdf(wallReflectance, false);
     sphere.areaRadiance = radiance;
     sphere.exteriorMedium = 0;  // flipped: the inside is the exterior side
     scene.shapes.push_back(sphere);
@@ -145,6 +145,60 @@ SceneDescription glassAndMirrorRoom(const Rgb& sigmaS, const Rgb& sigmaA, float 
     mirror.bsdf = BsdfDescription{};
     mirror.bsdf->kind = BsdfDescription::Kind::Conductor;  // Mitsuba's default: copper
     scene.shapes.push_back(mirror);
+    return scene;
+}
+
+SceneDescription glossyLitRoom(const Rgb& sigmaS, const Rgb& sigmaA, float g, const Rgb& sigmaS2) {
+    SceneDescription scene = litRoomWithOccluder(sigmaS, sigmaA, g);
+    BsdfDescription roughPlastic;
+    roughPlastic.kind = BsdfDescription::Kind::RoughPlastic;
+    roughPlastic.reflectance.value = Rgb(0.6f, 0.55f, 0.5f);
+    roughPlastic.alphaU = roughPlastic.alphaV = 0.1f;
+    roughPlastic.twoSided = true;
+    scene.shapes[0].bsdf = roughPlastic;  // the room
+    BsdfDescription plastic;
+    plastic.kind = BsdfDescription::Kind::Plastic;
+    plastic.reflectance.value = Rgb(0.3f, 0.5f, 0.7f);
+    scene.shapes[1].bsdf = plastic;  // the occluder
+    scene.shapes[2].toWorld = Transform::scale(Vec3(0.8f)).then(Transform::rotate(Vec3(1, 0, 0), 90.0f)).then(
+        Transform::translate(Vec3(-0.8f, 1.95f, 0.8f)));  // a larger light: 1.6 x 1.6
+    ShapeDescription metal;
+    metal.kind = ShapeDescription::Kind::Rectangle;
+    metal.toWorld = Transform::scale(Vec3(0.9f)).then(Transform::rotate(Vec3(0, 1, 0), -90.0f)).then(
+        Transform::translate(Vec3(1.95f, -0.2f, 0.9f)));  // +z rotated to -x: faces into the room
+    metal.bsdf = BsdfDescription{};
+    metal.bsdf->kind = BsdfDescription::Kind::RoughConductor;
+    metal.bsdf->alphaU = metal.bsdf->alphaV = 0.05f;
+    scene.shapes.push_back(metal);
+    scene.media.push_back(medium("haze", sigmaS2, Rgb(0.0f), 0.0f));
+    ShapeDescription haze;
+    haze.kind = ShapeDescription::Kind::Cube;
+    haze.toWorld = Transform::scale(Vec3(0.6f, 0.5f, 0.6f)).then(Transform::translate(Vec3(-0.8f, 0.9f, 0.8f)));
+    haze.bsdf = test::nullBsdf();
+    haze.interiorMedium = 1;
+    haze.exteriorMedium = 0;
+    scene.shapes.push_back(haze);
+    return scene;
+}
+
+SceneDescription glossyFloorUnderAreaLight(float alpha) {
+    SceneDescription scene;
+    scene.sensor = cameraAtOrigin(16, 12, 60.0f);
+    scene.sensor.toWorld = Transform::lookAt(Vec3(0.0f, 1.0f, -2.0f), Vec3(0.0f, 0.0f, 1.0f), Vec3(0, 1, 0));
+    ShapeDescription floor;
+    floor.kind = ShapeDescription::Kind::Rectangle;
+    floor.toWorld = Transform::scale(Vec3(4.0f)).then(Transform::rotate(Vec3(1, 0, 0), -90.0f));  // +z to +y
+    floor.bsdf = BsdfDescription{};
+    floor.bsdf->kind = BsdfDescription::Kind::RoughConductor;
+    floor.bsdf->alphaU = floor.bsdf->alphaV = alpha;
+    scene.shapes.push_back(floor);
+    ShapeDescription panel;
+    panel.kind = ShapeDescription::Kind::Rectangle;
+    panel.toWorld = Transform::scale(Vec3(0.6f)).then(Transform::rotate(Vec3(1, 0, 0), 90.0f)).then(
+        Transform::translate(Vec3(0.0f, 1.5f, 2.0f)));  // +z to -y: faces the floor
+    panel.areaRadiance = Rgb(5.0f, 4.0f, 3.0f);
+    panel.bsdf = test::diffuseBsdf(Rgb(0.0f), false);
+    scene.shapes.push_back(panel);
     return scene;
 }
 

@@ -24,9 +24,11 @@ inline BsdfDescription nullBsdf() {
 SensorDescription cameraAtOrigin(int width, int height, float fovDegrees);
 
 // Closed sphere (radius 1, centred on the camera) emitting `radiance` inwards,
-// black walls, filled with a non-absorbing medium of scattering `sigmaS`:
-// every pixel's expected radiance is exactly `radiance`.
-SceneDescription emittingSphereFurnace(const Rgb& radiance, const Rgb& sigmaS, float g);
+// diffuse walls of `wallReflectance` (default black), filled with a non-absorbing
+// medium of scattering `sigmaS`: every pixel's expected radiance is exactly
+// radiance / (1 - wallReflectance).
+SceneDescription emittingSphereFurnace(const Rgb& radiance, const Rgb& sigmaS, float g,
+                                       const Rgb& wallReflectance = Rgb(0.0f));
 
 // A camera in vacuum looking through a slab (thickness `thickness` along z,
 // null boundary) of pure absorber `sigmaA` at a large area light of radiance
@@ -51,6 +53,19 @@ SceneDescription litRoomWithOccluder(const Rgb& sigmaS, const Rgb& sigmaA, float
 // outside) in front of the occluder and a copper mirror on the right wall:
 // camera paths reach the medium through glass and in the mirror.
 SceneDescription glassAndMirrorRoom(const Rgb& sigmaS, const Rgb& sigmaA, float g);
+
+// litRoomWithOccluder with glossy surfaces for MIS: two-sided rough-plastic walls
+// (Beckmann alpha 0.1), a smooth-plastic occluder (a Dirac coating over a diffuse
+// base), a rough-conductor panel on the right wall (alpha 0.05), the area light
+// enlarged to 1.6 x 1.6, and a null-bounded box of a second medium (sigmaS2, no
+// absorption) below it, so paths to the light cross null boundaries.
+SceneDescription glossyLitRoom(const Rgb& sigmaS, const Rgb& sigmaA, float g, const Rgb& sigmaS2);
+
+// Vacuum: a rough-conductor floor (Beckmann `alpha`, y = 0 facing up) under a
+// 1.2 x 1.2 area light facing down at height 1.5; the camera (16 x 12) sees the
+// light's glossy reflection. Direct lighting on a glossy surface: the case where
+// NEE alone is noisy and BSDF sampling is not.
+SceneDescription glossyFloorUnderAreaLight(float alpha);
 
 // A closed room (cube of half-size 2) with two-sided diffuse walls, a diffuse
 // sphere, a spot light and a scene-filling medium: a little of everything.
