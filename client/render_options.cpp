@@ -27,10 +27,11 @@ void addRenderOptions(CLI::App& cmd, RenderCommandOptions& o) {
     cmd.add_option("--method", o.method,
                     "Rendering method (default: the scene's <integrator type> if it names one of these, else "
                     "vrl-lightcuts, the headline method): path (volumetric path tracer, the reference), vrl (transport parts "
-                    "(a)-(c) by path sampling, multiple scattering (d) by plain VRLs), vrl-lightcuts (the same, "
-                    "(d) by cuts through a VRL light tree) or vpl-lightcuts (the paper's baseline: (d) by Lightcuts "
-                    "over VPLs at the light paths' medium collisions, 32 stratified distance samples per camera "
-                    "segment, no clamping; vpl: the same with every VPL gathered, no tree)")
+                    "(a), (b) by path sampling, VRL-lit surfaces (c) and multiple scattering (d) by plain VRLs), "
+                    "vrl-lightcuts (the same, (c) and (d) by cuts through a VRL light tree) or vpl-lightcuts (the "
+                    "paper's baseline: (d) by Lightcuts over VPLs at the light paths' medium collisions, 32 stratified "
+                    "distance samples per camera segment, (c) path-sampled; vpl: the same with every VPL gathered, no "
+                    "tree). No method clamps contributions")
         ->check(CLI::IsMember(renderMethodNames()));
     cmd.add_option("--spp", o.spp, "Samples per pixel (default: the scene's sampler sampleCount)")
         ->check(CLI::Range(1, kMaxSampleCount));
