@@ -69,7 +69,14 @@ Rgb SurfaceClusterBound::bound(int32_t index, const CameraPathSurface& x, bool* 
     if (reflectsOnly && linearRange(node.box, x.hit.geometricNormal * side, p).second < -slack) return Rgb(0.0f);
 
     Rgb fCos;
-    if (const std::optional<Rgb> lambert = bsdf.lambertianBound(x.hit.uv)) {
+    const std::optional<Rgb> lambert = bsdf.lambertianBound(x.hit.uv);
+    // Glossy: a box that spans a wide cone from x may hold the lobe's peak between
+    // its corners; refine it (no bound) until it is narrow.
+    if (!lambert && double((node.box.max - node.box.min).length()) > d) {
+        if (xInsideNode) *xInsideNode = true;
+        return Rgb(std::numeric_limits<float>::infinity());
+    }
+    if (lambert) {
         const auto [lo, hi] = linearRange(node.box, x.hit.shadingNormal, p);
         const double cosine = std::min(1.0, (std::max(std::abs(lo), std::abs(hi)) + slack) / d);
         fCos = *lambert * float(cosine);

@@ -27,9 +27,10 @@
 // With Phi_C L_rep = the node's flux x length:
 //   bound = fluxLength sigma_s f_p,max (rho/pi) cos_max T_r(d) throughput / d^2.
 // Glossy models (every non-diffuse kind with a non-Dirac lobe) have no such
-// bound here: theirs is glossyMargin times the largest f_s|cos| over the box's
-// corners and centre (a heuristic; CutStatistics::boundExceeded counts the
-// estimates above it). Float rounding of sample points: d is taken a few float
+// bound here: a node whose box diagonal exceeds its distance d has none (the
+// cut refines it, as if x were inside), and a narrower one gets glossyMargin
+// times the largest f_s|cos| over the box's corners and centre (a heuristic;
+// CutStatistics::boundExceeded counts the estimates above it). Float rounding of sample points: d is taken a few float
 // steps closer and the bound carries a 1.001 margin, as in cluster_bound.h.
 #pragma once
 
@@ -47,7 +48,8 @@ public:
     SurfaceClusterBound(const Scene& scene, const LightTree& tree, ClusterBoundSettings settings = {});
 
     // RGB bound for `node` lighting `x`; +infinity (and *xInsideNode = true) when
-    // x lies in the node's box (or on one of a small node's segments).
+    // x lies in the node's box (or on one of a small node's segments), or the
+    // surface is glossy and the box too wide as seen from x.
     Rgb bound(int32_t node, const CameraPathSurface& x, bool* xInsideNode = nullptr) const;
     // The distance from x to the node used by the bound (box, or exact for small nodes).
     double minimumDistance(int32_t node, const Vec3& x) const;
