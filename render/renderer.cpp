@@ -217,7 +217,9 @@ TileImages TileShader::renderTile(const TileRect& tile, const RenderStop& stop) 
             for (size_t p = 0; p < 4; ++p) parts[p] /= spp;
             // (c) and (d) by VRLs once per pixel: their cost is per VRL, not per camera sample.
             CutStatistics cut, surfaceCut;
-            const auto lit = integrator_->virtualLightParts(cameraRay(camera, settings_, x, y, rng), rng, &cut, &surfaceCut);
+            const float pathLuminance = std::max(0.0f, luminance(parts[0] + parts[1] + parts[2]));
+            const auto lit = integrator_->virtualLightParts(cameraRay(camera, settings_, x, y, rng), rng, &cut,
+                                                            &surfaceCut, pathLuminance);
             if (integrator_->vrlLitSurfaces()) parts[size_t(TransportPart::MediumSurface)] = lit.mediumSurface;
             parts[size_t(TransportPart::Multiple)] = lit.multiple;
             Rgb sum(0.0f);

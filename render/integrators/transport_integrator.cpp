@@ -99,7 +99,8 @@ Rgb TransportIntegrator::mediumToSurface(const CameraSegment& segment, Rng& rng)
 
 TransportIntegrator::VirtualLightParts TransportIntegrator::virtualLightParts(const Ray& cameraRay, Rng& rng,
                                                                            CutStatistics* multipleStatistics,
-                                                                           CutStatistics* surfaceStatistics) const {
+                                                                           CutStatistics* surfaceStatistics,
+                                                                           float pathLuminance) const {
     VirtualLightParts parts;
     const bool multiple = settings_.transports.has(TransportPart::Multiple);
     const bool surface = vrlLitSurfaces() && settings_.transports.has(TransportPart::MediumSurface);
@@ -110,12 +111,10 @@ TransportIntegrator::VirtualLightParts TransportIntegrator::virtualLightParts(co
     // the cut's approximation.
     const uint64_t pixelKey = (uint64_t(rng.nextUint()) << 32) | rng.nextUint();
     const CameraPath path = cameraPath(scene_, cameraRay, scene_.cameraMedium(), &rng, settings_.maxDepth);
-    if (surface && path.surface)
-        parts.mediumSurface = vrlLitSurface(*path.surface, Rng::combine(pixelKey, ~uint64_t(0)),
-                                            surfaceStatistics ? *surfaceStatistics : unused);
-    if (!multiple) return parts;
+    // (d) first: (c)'s cut measures its error against the pixel's other parts.
     uint64_t segmentIndex = 0;
     for (const CameraSegment& segment : path.segments) {
+        if (!multiple) break;
         const uint64_t streamKey = Rng::combine(pixelKey, segmentIndex++);
         if (scene_.media()[segment.medium].isNonScattering()) continue;
         CutStatistics& statistics = multipleStatistics ? *multipleStatistics : unused;
@@ -134,12 +133,17 @@ TransportIntegrator::VirtualLightParts TransportIntegrator::virtualLightParts(co
             }
         }
     }
+    if (surface && path.surface)
+        parts.mediumSurface = vrlLitSurface(*path.surface, Rng::combine(pixelKey, ~uint64_t(0)),
+                                            surfaceStatistics ? *surfaceStatistics : unused,
+                                            pathLuminance + std::max(0.0f, luminance(parts.multiple)));
     return parts;
 }
 
-Rgb TransportIntegrator::vrlLitSurface(const CameraPathSurface& x, uint64_t streamKey, CutStatistics& statistics) const {
+Rgb TransportIntegrator::vrlLitSurface(const CameraPathSurface& x, uint64_t streamKey, CutStatistics& statistics,
+                                       float otherLuminance) const {
     if (settings_.maxDepth >= 0 && settings_.maxDepth < x.specularBefore + 3) return Rgb(0.0f);
-    if (surfaceLightcuts_) return surfaceLightcuts_->estimate(x, streamKey, statistics);
+    if (surfaceLightcuts_) return surfaceLightcuts_->estimate(x, streamKey, statistics, otherLuminance);
     Rgb sum(0.0f);
     const auto& vrls = tree_ ? tree_->vrls() : vrls_.vrls;
     for (uint32_t k = 0; k < vrls.size(); ++k) {

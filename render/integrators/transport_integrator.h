@@ -64,12 +64,14 @@ public:
 
     // The virtual-light parts for one camera ray: (c) at the surface the camera
     // path reaches (VRL methods) and (d) along its medium segments, each from every
-    // light or a cut, with the cuts' counters.
+    // light or a cut, with the cuts' counters. (c)'s cut measures its error against
+    // the whole pixel: its own total, (d)'s, and `pathLuminance`, the luminance of
+    // the path-sampled parts (a), (b) of the pixel (0: against (c) alone).
     struct VirtualLightParts {
         Rgb mediumSurface{0.0f}, multiple{0.0f};
     };
     VirtualLightParts virtualLightParts(const Ray& cameraRay, Rng& rng, CutStatistics* multipleStatistics = nullptr,
-                                        CutStatistics* surfaceStatistics = nullptr) const;
+                                        CutStatistics* surfaceStatistics = nullptr, float pathLuminance = 0.0f) const;
 
     // Part (c) is estimated from VRLs (not path-sampled).
     bool vrlLitSurfaces() const { return !settings_.vpls; }
@@ -77,7 +79,8 @@ public:
 private:
     Rgb singleScattering(const CameraSegment& segment, Rng& rng) const;
     Rgb mediumToSurface(const CameraSegment& segment, Rng& rng) const;
-    Rgb vrlLitSurface(const CameraPathSurface& x, uint64_t streamKey, CutStatistics& statistics) const;
+    Rgb vrlLitSurface(const CameraPathSurface& x, uint64_t streamKey, CutStatistics& statistics,
+                      float otherLuminance) const;
 
     const Scene& scene_;
     const VrlSet& vrls_;

@@ -21,8 +21,13 @@
 
 namespace vrl {
 
+// `otherLuminance`: the luminance of what the pixel receives besides this cut
+// (0: the cut's own total is the reference, as in the paper's part (d)); the
+// threshold then applies to the pixel's total, as Lightcuts' relative error
+// does (Walter et al. 2005: a fraction of the pixel's value).
 template <class Visitor>
-Rgb walkCut(const LightTree& tree, const CutSettings& settings, CutStatistics& statistics, Visitor&& visitor) {
+Rgb walkCut(const LightTree& tree, const CutSettings& settings, CutStatistics& statistics, Visitor&& visitor,
+            float otherLuminance = 0.0f) {
     struct CutNode {
         float bound;  // luminance of the node's bound
         int32_t node;
@@ -65,7 +70,7 @@ Rgb walkCut(const LightTree& tree, const CutSettings& settings, CutStatistics& s
     addToCut(tree.root());
     while (!heap.empty()) {
         const CutNode& top = heap.top();
-        if (top.bound <= settings.errorThreshold * std::max(0.0f, luminance(total))) break;
+        if (top.bound <= settings.errorThreshold * (std::max(0.0f, luminance(total)) + otherLuminance)) break;
         if (heap.size() + leavesInCut >= settings.maxCutSize) break;
         const CutNode refined = top;
         heap.pop();

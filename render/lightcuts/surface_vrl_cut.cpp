@@ -9,8 +9,8 @@ SurfaceLightcutsEstimator::SurfaceLightcutsEstimator(const Scene& scene, const L
                                                      const VrlSurfaceEstimator& estimator, CutSettings settings)
     : tree_(tree), estimator_(estimator), settings_(settings), bound_(scene, tree, settings.bound) {}
 
-Rgb SurfaceLightcutsEstimator::estimate(const CameraPathSurface& x, uint64_t streamKey,
-                                        CutStatistics& statistics) const {
+Rgb SurfaceLightcutsEstimator::estimate(const CameraPathSurface& x, uint64_t streamKey, CutStatistics& statistics,
+                                        float otherLuminance) const {
     if (tree_.empty()) return Rgb(0.0f);
     struct Visitor {
         const SurfaceLightcutsEstimator& self;
@@ -34,7 +34,7 @@ Rgb SurfaceLightcutsEstimator::estimate(const CameraPathSurface& x, uint64_t str
             return self.estimator_.contribution(representative, x, rng);
         }
     };
-    return walkCut(tree_, settings_, statistics, Visitor{*this, x, streamKey});
+    return walkCut(tree_, settings_, statistics, Visitor{*this, x, streamKey}, otherLuminance);
 }
 
 }  // namespace vrl

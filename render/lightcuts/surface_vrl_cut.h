@@ -3,7 +3,9 @@
 // part (d). Each node in the cut is estimated by its representative VRL with
 // the cluster flux Phi_C (VrlSurfaceEstimator); the node with the largest
 // SurfaceClusterBound is refined while that bound exceeds errorThreshold x
-// (luminance of the running total). A node whose box holds x has no bound and is
+// (luminance of the running total plus the pixel's other parts: (c) is often a
+// small share of a surface pixel, and the paper's error is relative to the
+// pixel). A node whose box holds x has no bound and is
 // refined without being estimated (#Inter); leaves are single VRLs.
 #pragma once
 
@@ -23,7 +25,10 @@ public:
 
     // Part (c) at x from every VRL of the tree. VRL k draws from vrlStream(streamKey, k)
     // as in plain VRL shading, so a cluster's estimate is its representative's plain sample rescaled.
-    Rgb estimate(const CameraPathSurface& x, uint64_t streamKey, CutStatistics& statistics) const;
+    // The threshold applies to the cut's total plus `otherLuminance`, the luminance of
+    // the pixel's other parts (cut_walk.h).
+    Rgb estimate(const CameraPathSurface& x, uint64_t streamKey, CutStatistics& statistics,
+                 float otherLuminance = 0.0f) const;
 
 private:
     const LightTree& tree_;

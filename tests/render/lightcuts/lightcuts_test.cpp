@@ -73,6 +73,18 @@ TEST(Lightcuts, SurfaceErrorShrinksWithThresholdInLitRoom) {
     expectErrorControl(*scene, "lit room", "medium-surface");
 }
 
+// The whole four-part image: the path-sampled parts draw the same numbers in
+// both methods, so the images differ by the two cuts alone; part (c)'s cut
+// measures its error against the whole pixel, and the image's relative RMSE
+// against plain VRLs stays below the threshold.
+TEST(Lightcuts, WholeImageErrorBelowThresholdOnDefaultScene) {
+    SceneDescription d = parseMitsubaScene(std::filesystem::path(VRL_TEST_DATA_DIR) / "../scenes/smoke-room.xml");
+    d.sensor.width = 24;
+    d.sensor.height = 18;
+    const auto scene = Scene::build(d);
+    expectErrorControl(*scene, "smoke-room", "surface,single,medium-surface,multiple");
+}
+
 // Part (c)'s counters are their own layers, after part (d)'s.
 TEST(Lightcuts, SurfaceStatisticsLayers) {
     const auto scene = Scene::build(test::litRoomWithOccluder(Rgb(0.4f), Rgb(0.1f), 0.0f));
