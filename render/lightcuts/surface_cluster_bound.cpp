@@ -70,25 +70,28 @@ Rgb SurfaceClusterBound::bound(int32_t index, const CameraPathSurface& x, bool* 
 
     Rgb fCos;
     const std::optional<Rgb> lambert = bsdf.lambertianBound(x.hit.uv);
-    // Glossy: a box that spans a wide cone from x may hold the lobe's peak between
-    // its corners; refine it (no bound) until it is narrow.
-    if (!lambert && double((node.box.max - node.box.min).length()) > d) {
-        if (xInsideNode) *xInsideNode = true;
-        return Rgb(std::numeric_limits<float>::infinity());
-    }
     if (lambert) {
         const auto [lo, hi] = linearRange(node.box, x.hit.shadingNormal, p);
         const double cosine = std::min(1.0, (std::max(std::abs(lo), std::abs(hi)) + slack) / d);
         fCos = *lambert * float(cosine);
     } else {
-        // Glossy: the largest f|cos| towards the box's corners and centre, with a margin (a heuristic).
+        // Glossy: the largest f|cos| towards the box's corners, its centre and its
+        // point nearest the mirror direction (where a lobe peaks), with a margin (a heuristic).
         const ShadingPoint sp = x.hit.shadingPoint();
+        const Vec3 n = x.hit.shadingNormal * (x.wo.dot(x.hit.shadingNormal) >= 0.0f ? 1.0f : -1.0f);
+        const Vec3 mirror = n * (2.0f * x.wo.dot(n)) - x.wo;
+        const float along = std::max(0.0f, mirror.dot(node.box.center() - p));
+        const Vec3 onMirror = p + mirror * along;
+        const Vec3 nearMirror(std::clamp(onMirror.x, node.box.min.x, node.box.max.x),
+                              std::clamp(onMirror.y, node.box.min.y, node.box.max.y),
+                              std::clamp(onMirror.z, node.box.min.z, node.box.max.z));
         Rgb largest(0.0f);
-        for (int corner = 0; corner < 9; ++corner) {
-            const Vec3 q = corner == 8 ? node.box.center()
-                                       : Vec3(corner & 1 ? node.box.max.x : node.box.min.x,
-                                              corner & 2 ? node.box.max.y : node.box.min.y,
-                                              corner & 4 ? node.box.max.z : node.box.min.z);
+        for (int corner = 0; corner < 10; ++corner) {
+            const Vec3 q = corner == 9   ? nearMirror
+                           : corner == 8 ? node.box.center()
+                                         : Vec3(corner & 1 ? node.box.max.x : node.box.min.x,
+                                                corner & 2 ? node.box.max.y : node.box.min.y,
+                                                corner & 4 ? node.box.max.z : node.box.min.z);
             const Vec3 to = q - p;
             const float length = to.length();
             if (!(length > 0.0f)) continue;
