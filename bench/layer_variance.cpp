@@ -6,10 +6,12 @@
 // the per-pixel standard deviations over the mean), and its share of the sum
 // of the parts' variances (the parts use different random numbers, so that
 // sum is about the image's variance; the VRLs both VRL parts use are shared,
-// and their covariance is the difference, printed too). Counter layers
+// and their covariance is the difference, printed too), and its brightest
+// pixel in any run (a firefly shows there first). Counter layers
 // (single-channel) are skipped.
 #include "render/image/exr_io.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <map>
@@ -24,6 +26,7 @@ double luminanceOf(const Rgb& c) { return 0.2126 * c.x + 0.7152 * c.y + 0.0722 *
 
 struct LayerNoise {
     double mean = 0.0, variance = 0.0;
+    double largest = 0.0;  // the brightest pixel of any run (fireflies)
 };
 
 LayerNoise noiseOf(const std::vector<const Image*>& runs) {
@@ -33,6 +36,7 @@ LayerNoise noiseOf(const std::vector<const Image*>& runs) {
         double sum = 0.0, sum2 = 0.0;
         for (const Image* run : runs) {
             const double y = luminanceOf((*run)[p]);
+            out.largest = std::max(out.largest, y);
             sum += y;
             sum2 += y * y;
         }
@@ -80,10 +84,10 @@ int main(int argc, char** argv) {
         partsVariance += parts.back().second.variance;
     }
     std::printf("%zu runs, %dx%d\n", runs.size(), runs[0].image.width(), runs[0].image.height());
-    std::printf("%-16s %12s %12s %12s %10s\n", "layer", "mean", "variance", "rel. noise", "share");
+    std::printf("%-16s %12s %12s %12s %10s %12s\n", "layer", "mean", "variance", "rel. noise", "share", "brightest");
     const auto row = [&](const std::string& name, const LayerNoise& n, double share) {
-        std::printf("%-16s %12.5g %12.5g %12.4f %9.1f%%\n", name.c_str(), n.mean, n.variance,
-                    n.mean > 0.0 ? std::sqrt(n.variance) / n.mean : 0.0, 100.0 * share);
+        std::printf("%-16s %12.5g %12.5g %12.4f %9.1f%% %12.5g\n", name.c_str(), n.mean, n.variance,
+                    n.mean > 0.0 ? std::sqrt(n.variance) / n.mean : 0.0, 100.0 * share, n.largest);
     };
     row("(image)", image, partsVariance > 0.0 ? image.variance / partsVariance : 0.0);
     for (const auto& [name, n] : parts) row(name, n, partsVariance > 0.0 ? n.variance / partsVariance : 0.0);

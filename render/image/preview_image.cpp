@@ -42,6 +42,7 @@ void writePreviewPng(const Image& image, const std::filesystem::path& png, float
         util::writeAtomically(png, [&](const std::filesystem::path& tmp) {
             auto output = OIIO::ImageOutput::create("png");
             if (!output) throw fail(OIIO::geterror());
+            output->threads(1);  // no OIIO thread pool to tear down at exit (texture.cpp says why)
             OIIO::ImageSpec spec(image.width(), image.height(), 3, OIIO::TypeDesc::UINT8);
             spec.attribute("oiio:ColorSpace", "sRGB");
             if (!output->open(tmp.string(), spec)) throw fail(output->geterror());

@@ -188,6 +188,11 @@ std::shared_ptr<const Texture> Texture::load(const TextureDescription& descripti
         const std::string message = OIIO::geterror();
         throw fail("cannot read the image: " + (message.empty() ? std::string("unknown format") : message));
     }
+    // Decode on this thread: OIIO's shared thread pool, started by a parallel
+    // conversion, is torn down by static destructors at exit, where OIIO 2.4 can
+    // crash (seen once: a staircase render exited with SIGSEGV in
+    // libOpenImageIO after writing its image; OIIO issue #3295).
+    input->threads(1);
     const OIIO::ImageSpec spec = input->spec();
     if (spec.width <= 0 || spec.height <= 0 || spec.depth > 1 || spec.nchannels <= 0)
         throw fail("the image is empty (" + std::to_string(spec.width) + " x " + std::to_string(spec.height) + ", " +
