@@ -19,6 +19,23 @@ double simpson(F f, double a, double b, int n) {
     return sum * h / 3.0;
 }
 
+// Composite 8-point Gauss-Legendre rule on [lo, hi] with `panels` panels; f may
+// return any type with + and * double (double, Imath::V3d).
+template <class F>
+auto gaussLegendre(F f, double lo, double hi, int panels) {
+    static constexpr double x[4] = {0.1834346424956498, 0.5255324099163290, 0.7966664774136267,
+                                    0.9602898564975363};
+    static constexpr double w[4] = {0.3626837833783620, 0.3137066458778873, 0.2223810344533745,
+                                    0.1012285362903763};
+    decltype(f(lo)) sum = decltype(f(lo))(0);
+    const double width = (hi - lo) / panels;
+    for (int p = 0; p < panels; ++p) {
+        const double mid = lo + (p + 0.5) * width, half = 0.5 * width;
+        for (int i = 0; i < 4; ++i) sum += (f(mid - half * x[i]) + f(mid + half * x[i])) * (w[i] * half);
+    }
+    return sum;
+}
+
 // Pearson's statistic, pooling bins (in increasing order of expectation) until
 // every pooled bin expects at least 5 samples, as pbrt's Chi2Test does.
 struct ChiSquare {

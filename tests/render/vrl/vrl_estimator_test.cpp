@@ -28,6 +28,7 @@ namespace {
 
 using test::chiSquare;
 using test::chiSquareCritical;
+using test::gaussLegendre;
 using test::simpson;
 using V3d = Imath::V3d;
 
@@ -41,21 +42,6 @@ V3d expD(const V3d& v) { return {std::exp(v.x), std::exp(v.y), std::exp(v.z)}; }
 
 // ---- Reference quadrature ---------------------------------------------------
 
-// Composite 8-point Gauss-Legendre rule on [lo, hi] with `panels` panels.
-template <class F>
-auto gaussLegendre(F f, double lo, double hi, int panels) {
-    static constexpr double x[4] = {0.1834346424956498, 0.5255324099163290, 0.7966664774136267,
-                                    0.9602898564975363};
-    static constexpr double w[4] = {0.3626837833783620, 0.3137066458778873, 0.2223810344533745,
-                                    0.1012285362903763};
-    decltype(f(lo)) sum = decltype(f(lo))(0);
-    const double width = (hi - lo) / panels;
-    for (int p = 0; p < panels; ++p) {
-        const double mid = lo + (p + 0.5) * width, half = 0.5 * width;
-        for (int i = 0; i < 4; ++i) sum += (f(mid - half * x[i]) + f(mid + half * x[i])) * (w[i] * half);
-    }
-    return sum;
-}
 
 struct MediumParams {
     V3d sigmaS, sigmaT;

@@ -13,6 +13,7 @@
 #include "render/vrl/vrl_surface_estimator.h"
 
 #include "render/scene/scene.h"
+#include "tests/support/statistics.h"
 #include "tests/support/test_scenes.h"
 
 #include <gtest/gtest.h>
@@ -24,6 +25,7 @@ namespace vrl {
 namespace {
 
 using V3d = Imath::V3d;
+using test::gaussLegendre;
 constexpr double kPiD = 3.14159265358979323846;
 constexpr double kSigmas = 3.5;
 constexpr int kSamples = 200'000;
@@ -36,19 +38,6 @@ double hg(double g, double cosine) {
     return (1 - g * g) / (4 * kPiD * denom * std::sqrt(denom));
 }
 
-// Composite 8-point Gauss-Legendre on [lo, hi].
-template <class F>
-V3d gaussLegendre(F f, double lo, double hi, int panels) {
-    static constexpr double x[4] = {0.1834346424956498, 0.5255324099163290, 0.7966664774136267, 0.9602898564975363};
-    static constexpr double w[4] = {0.3626837833783620, 0.3137066458778873, 0.2223810344533745, 0.1012285362903763};
-    V3d sum(0.0);
-    const double width = (hi - lo) / panels;
-    for (int p = 0; p < panels; ++p) {
-        const double mid = lo + (p + 0.5) * width, half = 0.5 * width;
-        for (int i = 0; i < 4; ++i) sum += (f(mid - half * x[i]) + f(mid + half * x[i])) * (w[i] * half);
-    }
-    return sum;
-}
 
 struct Medium {
     Rgb sigmaS, sigmaA;
