@@ -219,6 +219,16 @@ int runRender(const RenderCommandOptions& o, const CLI::App& command) {
     if (usesLightTree(settings.method)) {
         std::fprintf(stderr, "  light tree %.3f s, %.1f MiB\n", stats.treeSeconds,
                      double(stats.treeBytes) / (1024.0 * 1024.0));
+        const bool stochastic = settings.method == RenderMethod::VrlStochastic;
+        if (stochastic) {
+            if (settings.transports.has(TransportPart::Multiple))
+                std::fprintf(stderr, "  per pixel and sample, (d) medium-to-medium: #Eval %.1f, importances %.1f, cut size %.1f\n",
+                             stats.meanEvaluated, stats.meanImportance, stats.meanCutSize);
+            if (settings.transports.has(TransportPart::MediumSurface))
+                std::fprintf(stderr, "  per pixel and sample, (c) medium-to-surface: #Eval %.1f, importances %.1f, cut size %.1f\n",
+                             stats.surfaceMeanEvaluated, stats.surfaceMeanImportance, stats.surfaceMeanCutSize);
+            return 0;
+        }
         if (settings.transports.has(TransportPart::Multiple))
             std::fprintf(stderr, "  per pixel, (d) medium-to-medium: #Eval %.1f, #Inter %.1f, cut size %.1f\n",
                          stats.meanEvaluated, stats.meanIntersected, stats.meanCutSize);

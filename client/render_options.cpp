@@ -28,7 +28,9 @@ void addRenderOptions(CLI::App& cmd, RenderCommandOptions& o) {
                     "Rendering method (default: the scene's <integrator type> if it names one of these, else "
                     "vrl-lightcuts, the headline method): path (volumetric path tracer, the reference), vrl (transport parts "
                     "(a), (b) by path sampling, VRL-lit surfaces (c) and multiple scattering (d) by plain VRLs), "
-                    "vrl-lightcuts (the same, (c) and (d) by cuts through a VRL light tree) or vpl-lightcuts (the "
+                    "vrl-lightcuts (the same, (c) and (d) by cuts through a VRL light tree), vrl-stochastic (stochastic "
+                    "VRL Lightcuts: (c) and (d) by small stochastic cuts through the same tree, one VRL drawn under each "
+                    "node, unbiased; --spp applies to (c) and (d) too) or vpl-lightcuts (the "
                     "paper's baseline: (d) by Lightcuts over VPLs at the light paths' medium collisions, 32 stratified "
                     "distance samples per camera segment, (c) path-sampled; vpl: the same with every VPL gathered, no "
                     "tree). No method clamps contributions")
@@ -90,6 +92,10 @@ void addRenderOptions(CLI::App& cmd, RenderCommandOptions& o) {
     cmd.add_option("--partition-size", o.partitionSize,
                     "vrl-lightcuts, vpl-lightcuts: lights per partition before agglomerative clustering (default 2048)")
         ->check(CLI::Range(2u, 1u << 30));
+    cmd.add_option("--cut-size", o.cutSize,
+                   "vrl-stochastic: nodes per stochastic cut, one VRL drawn under each (per camera segment and surface "
+                   "point, per sample; default 32)")
+        ->check(CLI::Range(1u, 1u << 20));
     cmd.add_flag("--pixel-centres", o.pixelCentres,
                  "Camera rays through pixel centres, the paper's setting (default: jittered inside each pixel, "
                  "antialiased, as Mitsuba and pbrt do; still bit-identical across threads and workers)");
@@ -99,7 +105,9 @@ void addRenderOptions(CLI::App& cmd, RenderCommandOptions& o) {
 void warnIneffectiveFlags(const CLI::App& command, RenderMethod method, bool distributed) {
     const bool virtualLights = usesVirtualLights(method);
     const bool tree = usesLightTree(method);
-    const bool vrls = method == RenderMethod::Vrl || method == RenderMethod::VrlLightcuts;
+    const bool vrls = method == RenderMethod::Vrl || method == RenderMethod::VrlLightcuts ||
+                      method == RenderMethod::VrlStochastic;
+    const bool deterministicCut = tree && method != RenderMethod::VrlStochastic;
     struct Rule {
         const char* flag;
         bool effective;
@@ -109,11 +117,12 @@ void warnIneffectiveFlags(const CLI::App& command, RenderMethod method, bool dis
         {"--vrls", virtualLights, "the virtual-light methods"},
         {"--light-paths", virtualLights, "the virtual-light methods"},
         {"--transport", virtualLights, "the virtual-light methods (path renders everything)"},
-        {"--vrl-samples", vrls, "vrl and vrl-lightcuts"},
-        {"--error", tree, "vrl-lightcuts and vpl-lightcuts"},
-        {"--max-cut", tree, "vrl-lightcuts and vpl-lightcuts"},
-        {"--hg-epsilon", tree, "vrl-lightcuts and vpl-lightcuts"},
-        {"--partition-size", tree, "vrl-lightcuts and vpl-lightcuts"},
+        {"--vrl-samples", vrls, "vrl, vrl-lightcuts and vrl-stochastic"},
+        {"--error", deterministicCut, "vrl-lightcuts and vpl-lightcuts"},
+        {"--max-cut", deterministicCut, "vrl-lightcuts and vpl-lightcuts"},
+        {"--hg-epsilon", deterministicCut, "vrl-lightcuts and vpl-lightcuts"},
+        {"--partition-size", tree, "vrl-lightcuts, vrl-stochastic and vpl-lightcuts"},
+        {"--cut-size", method == RenderMethod::VrlStochastic, "vrl-stochastic"},
         {"--exact-distance-below", method == RenderMethod::VrlLightcuts, "vrl-lightcuts"},
     };
     const std::string name(methodName(method));
@@ -196,6 +205,7 @@ v1::RenderParameters toRenderParameters(const RenderCommandOptions& o) {
     p.set_exact_distance_below(o.exactDistanceBelow);
     p.set_hg_epsilon(o.hgEpsilon);
     p.set_partition_size(o.partitionSize);
+    p.set_cut_size(o.cutSize);
     return p;
 }
 

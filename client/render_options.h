@@ -39,6 +39,7 @@ struct RenderCommandOptions {
     uint32_t exactDistanceBelow = 32;
     float hgEpsilon = 1.0f;
     uint32_t partitionSize = 2048;
+    uint32_t cutSize = 32;  // vrl-stochastic
     // Distributed rendering (render --workers, submit)
     int workers = 0;       // render: 0 embedded, N: a local coordinator and N worker processes
     uint32_t tileSize = 32;

@@ -37,21 +37,35 @@ void writeRenderMetadata(const RenderRecord& record, const PerspectiveCamera& ca
     }
     if (usesVpls(s.method)) metadata["vrl.vplDistanceSamples"] = int32_t(s.vplDistanceSamples);
     if (usesLightTree(s.method)) {
-        metadata["vrl.error"] = s.cut.errorThreshold;
-        metadata["vrl.maxCut"] = int32_t(s.cut.maxCutSize);
-        metadata["vrl.exactDistanceBelow"] = int32_t(s.cut.bound.exactDistanceBelow);
-        metadata["vrl.hgEpsilon"] = s.cut.bound.anisotropyEpsilon;
+        if (s.method == RenderMethod::VrlStochastic) {
+            metadata["vrl.cutSize"] = int32_t(s.cut.stochasticCutSize);
+        } else {
+            metadata["vrl.error"] = s.cut.errorThreshold;
+            metadata["vrl.maxCut"] = int32_t(s.cut.maxCutSize);
+            metadata["vrl.exactDistanceBelow"] = int32_t(s.cut.bound.exactDistanceBelow);
+            metadata["vrl.hgEpsilon"] = s.cut.bound.anisotropyEpsilon;
+        }
         metadata["vrl.partitionSize"] = int32_t(s.partitionSize);
         metadata["vrl.meanEval"] = stats.meanEvaluated;
-        metadata["vrl.meanInter"] = stats.meanIntersected;
+        // vrl-stochastic: per pixel and camera sample, importances instead of #Inter, no bounds.
+        const bool stochastic = s.method == RenderMethod::VrlStochastic;
+        if (stochastic)
+            metadata["vrl.meanImportance"] = stats.meanImportance;
+        else
+            metadata["vrl.meanInter"] = stats.meanIntersected;
         metadata["vrl.meanCut"] = stats.meanCutSize;
         if (s.transports.has(TransportPart::MediumSurface) && !usesVpls(s.method)) {
             metadata["vrl.surface.meanEval"] = stats.surfaceMeanEvaluated;
-            metadata["vrl.surface.meanInter"] = stats.surfaceMeanIntersected;
+            if (stochastic)
+                metadata["vrl.surface.meanImportance"] = stats.surfaceMeanImportance;
+            else
+                metadata["vrl.surface.meanInter"] = stats.surfaceMeanIntersected;
             metadata["vrl.surface.meanCut"] = stats.surfaceMeanCutSize;
         }
-        metadata["vrl.boundExceeded"] = double(stats.boundExceeded);
-        metadata["vrl.boundedEstimates"] = double(stats.boundedEstimates);
+        if (!stochastic) {
+            metadata["vrl.boundExceeded"] = double(stats.boundExceeded);
+            metadata["vrl.boundedEstimates"] = double(stats.boundedEstimates);
+        }
         metadata["vrl.time.treeBuild"] = stats.treeSeconds;
     }
     metadata["vrl.time.render"] = stats.seconds;

@@ -20,6 +20,10 @@ namespace {
 // Per-pixel cut counters: part (d)'s (the paper's Table 1), then part (c)'s.
 constexpr const char* kCutLayerNames[3] = {"eval", "inter", "cut"};
 constexpr const char* kSurfaceCutLayerNames[3] = {"medium-surface-eval", "medium-surface-inter", "medium-surface-cut"};
+// vrl-stochastic: VRL estimates, node importances computed and cut size, per pixel and camera sample.
+constexpr const char* kStochasticLayerNames[3] = {"eval", "importance", "cut"};
+constexpr const char* kSurfaceStochasticLayerNames[3] = {"medium-surface-eval", "medium-surface-importance",
+                                                         "medium-surface-cut"};
 
 // The ray of image pixel (x, y): through its film pixel, so a crop shades what the full film would.
 Ray cameraRay(const PerspectiveCamera& camera, const RenderSettings& settings, int x, int y, Rng& rng) {
@@ -47,6 +51,7 @@ std::string_view methodName(RenderMethod method) {
         case RenderMethod::Path: return "path";
         case RenderMethod::Vrl: return "vrl";
         case RenderMethod::VrlLightcuts: return "vrl-lightcuts";
+        case RenderMethod::VrlStochastic: return "vrl-stochastic";
         case RenderMethod::Vpl: return "vpl";
         case RenderMethod::VplLightcuts: return "vpl-lightcuts";
     }
@@ -72,6 +77,9 @@ void validateRenderSettings(const RenderSettings& settings) {
     if (settings.vrlSamples < 1) throw std::invalid_argument("samples per VRL must be at least 1");
     if (!(settings.cut.errorThreshold >= 0.0f)) throw std::invalid_argument("the error threshold must be >= 0");
     if (settings.vplDistanceSamples < 1) throw std::invalid_argument("VPL distance samples must be at least 1");
+    if (settings.cut.stochasticCutSize < 1 || settings.cut.stochasticCutSize > (1u << 20))
+        throw std::invalid_argument("the stochastic cut size must be in [1, 1048576], not " +
+                                    std::to_string(settings.cut.stochasticCutSize));
 }
 
 RenderLights prepareLights(const Scene& scene, const RenderSettings& settings, const ProgressCallback& progress,
@@ -136,9 +144,11 @@ std::vector<std::string> renderLayerNames(const RenderSettings& settings) {
     for (size_t p = 0; p < kTransportPartNames.size(); ++p)
         if (settings.transports.enabled[p]) names.emplace_back(kTransportPartNames[p]);
     if (usesLightTree(settings.method)) {
-        for (const char* name : kCutLayerNames) names.emplace_back(name);
+        const bool stochastic = settings.method == RenderMethod::VrlStochastic;
+        for (const char* name : stochastic ? kStochasticLayerNames : kCutLayerNames) names.emplace_back(name);
         if (vrlLitSurfaces(settings))
-            for (const char* name : kSurfaceCutLayerNames) names.emplace_back(name);
+            for (const char* name : stochastic ? kSurfaceStochasticLayerNames : kSurfaceCutLayerNames)
+                names.emplace_back(name);
     }
     return names;
 }
@@ -175,6 +185,7 @@ TileShader::TileShader(const Scene& scene, const RenderSettings& settings, const
                                                  settings.cut};
         integratorSettings.vpls = usesVpls(settings.method);
         integratorSettings.vplDistanceSamples = settings.vplDistanceSamples;
+        integratorSettings.stochastic = settings.method == RenderMethod::VrlStochastic;
         integrator_ = std::make_unique<TransportIntegrator>(scene, lights.vrls, integratorSettings,
                                                       lightcuts && lights.tree.root() >= 0 ? &lights.tree : nullptr);
     } else {
@@ -210,18 +221,28 @@ TileImages TileShader::renderTile(const TileRect& tile, const RenderStop& stop) 
                 continue;
             }
             std::array<Rgb, 4> parts{Rgb(0.0f), Rgb(0.0f), Rgb(0.0f), Rgb(0.0f)};
+            CutStatistics cut, surfaceCut;
+            const bool perSample = integrator_->virtualLightsPerSample();
+            const auto addVirtualLights = [&](const TransportIntegrator::VirtualLightParts& lit) {
+                if (integrator_->vrlLitSurfaces()) parts[size_t(TransportPart::MediumSurface)] += lit.mediumSurface;
+                parts[size_t(TransportPart::Multiple)] += lit.multiple;
+            };
             for (int s = 0; s < settings_.samplesPerPixel; ++s) {
-                const auto sample = integrator_->samplePathParts(cameraRay(camera, settings_, x, y, rng), rng);
+                const Ray ray = cameraRay(camera, settings_, x, y, rng);
+                const auto sample = integrator_->samplePathParts(ray, rng);
                 for (size_t p = 0; p < 4; ++p) parts[p] += sample[p];
+                // Stochastic cuts: (c) and (d) per camera sample, along the same ray.
+                if (perSample) addVirtualLights(integrator_->virtualLightParts(ray, rng, &cut, &surfaceCut));
             }
             for (size_t p = 0; p < 4; ++p) parts[p] /= spp;
-            // (c) and (d) by VRLs once per pixel: their cost is per VRL, not per camera sample.
-            CutStatistics cut, surfaceCut;
-            const float pathLuminance = std::max(0.0f, luminance(parts[0] + parts[1] + parts[2]));
-            const auto lit = integrator_->virtualLightParts(cameraRay(camera, settings_, x, y, rng), rng, &cut,
-                                                            &surfaceCut, pathLuminance);
-            if (integrator_->vrlLitSurfaces()) parts[size_t(TransportPart::MediumSurface)] = lit.mediumSurface;
-            parts[size_t(TransportPart::Multiple)] = lit.multiple;
+            if (!perSample) {
+                // (c) and (d) by VRLs once per pixel: their cost is per VRL, not per camera sample.
+                const float pathLuminance = std::max(0.0f, luminance(parts[0] + parts[1] + parts[2]));
+                addVirtualLights(integrator_->virtualLightParts(cameraRay(camera, settings_, x, y, rng), rng, &cut,
+                                                                &surfaceCut, pathLuminance));
+            }
+            // Counters per pixel and camera sample when (c), (d) are sampled per camera sample.
+            const float counterScale = perSample ? 1.0f / spp : 1.0f;
             Rgb sum(0.0f);
             size_t layer = 1;
             for (size_t p = 0; p < parts.size(); ++p) {
@@ -231,13 +252,15 @@ TileImages TileShader::renderTile(const TileRect& tile, const RenderStop& stop) 
             }
             out.layers[0].at(tx, ty) = sum;
             if (usesLightTree(settings_.method)) {
-                out.layers[layer++].at(tx, ty) = Rgb(float(cut.evaluated));
-                out.layers[layer++].at(tx, ty) = Rgb(float(cut.intersected));
-                out.layers[layer++].at(tx, ty) = Rgb(float(cut.cutSize));
+                out.layers[layer++].at(tx, ty) = Rgb(float(cut.evaluated) * counterScale);
+                out.layers[layer++].at(tx, ty) =
+                    Rgb(float(perSample ? cut.importanceEvaluations : cut.intersected) * counterScale);
+                out.layers[layer++].at(tx, ty) = Rgb(float(cut.cutSize) * counterScale);
                 if (layer < out.layers.size()) {
-                    out.layers[layer++].at(tx, ty) = Rgb(float(surfaceCut.evaluated));
-                    out.layers[layer++].at(tx, ty) = Rgb(float(surfaceCut.intersected));
-                    out.layers[layer++].at(tx, ty) = Rgb(float(surfaceCut.cutSize));
+                    out.layers[layer++].at(tx, ty) = Rgb(float(surfaceCut.evaluated) * counterScale);
+                    out.layers[layer++].at(tx, ty) =
+                        Rgb(float(perSample ? surfaceCut.importanceEvaluations : surfaceCut.intersected) * counterScale);
+                    out.layers[layer++].at(tx, ty) = Rgb(float(surfaceCut.cutSize) * counterScale);
                 }
                 out.boundExceeded += cut.boundExceeded + surfaceCut.boundExceeded;
                 out.boundedEstimates += cut.boundedEstimates + surfaceCut.boundedEstimates;
@@ -264,11 +287,17 @@ ImageSet assembleImageSet(std::vector<Image> layers, const std::vector<std::stri
             if (name == kSurfaceCutLayerNames[0]) statistics->surfaceMeanEvaluated = mean;
             if (name == kSurfaceCutLayerNames[1]) statistics->surfaceMeanIntersected = mean;
             if (name == kSurfaceCutLayerNames[2]) statistics->surfaceMeanCutSize = mean;
+            if (name == kStochasticLayerNames[1]) statistics->meanImportance = mean;
+            if (name == kSurfaceStochasticLayerNames[1]) statistics->surfaceMeanImportance = mean;
         }
         result.layers.emplace_back(name, std::move(layers[l + 1]));
         for (const char* counter : kCutLayerNames)
             if (name == counter) result.singleChannelLayers.insert(name);
         for (const char* counter : kSurfaceCutLayerNames)
+            if (name == counter) result.singleChannelLayers.insert(name);
+        for (const char* counter : kStochasticLayerNames)
+            if (name == counter) result.singleChannelLayers.insert(name);
+        for (const char* counter : kSurfaceStochasticLayerNames)
             if (name == counter) result.singleChannelLayers.insert(name);
     }
     return result;

@@ -34,18 +34,25 @@ namespace vrl {
 //         "medium-surface-inter", "medium-surface-cut" (those of (c)'s cuts)
 //   vpl:  the four parts, multiple scattering by plain VPLs (every VPL at each of
 //         the distance samples; the brute force VPL Lightcuts is measured against)
+//   vrl-stochastic: stochastic VRL Lightcuts: parts (c) and (d) by stochastic cuts
+//         of cut.stochasticCutSize nodes through the VRL light tree, one VRL drawn
+//         under each node (lightcuts/stochastic_vrl_cut.h): unbiased against plain
+//         VRLs; estimated per camera sample, so --spp applies to (c) and (d) too.
+//         Its counter layers are "eval", "importance", "cut" (and "medium-surface-eval",
+//         "-importance", "-cut"): VRL estimates, node importances computed and cut
+//         size, per pixel and camera sample.
 //   vpl-lightcuts: the same layers as vrl-lightcuts, multiple scattering by VPL
 //         Lightcuts (the paper's baseline, lightcuts/vpl_cut.h)
 // For vpl and vpl-lightcuts, vrlCount counts VPLs.
-enum class RenderMethod { Path, Vrl, VrlLightcuts, Vpl, VplLightcuts };
-inline constexpr std::array<RenderMethod, 5> kRenderMethods = {RenderMethod::Path, RenderMethod::Vrl,
-                                                               RenderMethod::VrlLightcuts, RenderMethod::Vpl,
-                                                               RenderMethod::VplLightcuts};
+enum class RenderMethod { Path, Vrl, VrlLightcuts, VrlStochastic, Vpl, VplLightcuts };
+inline constexpr std::array<RenderMethod, 6> kRenderMethods = {RenderMethod::Path,          RenderMethod::Vrl,
+                                                               RenderMethod::VrlLightcuts,  RenderMethod::VrlStochastic,
+                                                               RenderMethod::Vpl,           RenderMethod::VplLightcuts};
 // The method a job renders when neither it nor its scene's <integrator> names
 // one: the README's recommended method (the paper's, VRL Lightcuts).
 inline constexpr RenderMethod kHeadlineMethod = RenderMethod::VrlLightcuts;
 
-// "path", "vrl", "vrl-lightcuts", "vpl", "vpl-lightcuts".
+// "path", "vrl", "vrl-lightcuts", "vrl-stochastic", "vpl", "vpl-lightcuts".
 std::string_view methodName(RenderMethod method);
 // Every method's name, in kRenderMethods order (for the command line's choices).
 std::vector<std::string> renderMethodNames();
@@ -54,10 +61,12 @@ RenderMethod parseRenderMethod(std::string_view name);
 
 // The method deposits VPLs (points) rather than VRLs.
 constexpr bool usesVpls(RenderMethod m) { return m == RenderMethod::Vpl || m == RenderMethod::VplLightcuts; }
-// The method builds a light tree (VRL or VPL Lightcuts): it ships a tree, not a VRL set.
+// The method builds a light tree (VRL, stochastic VRL or VPL Lightcuts): it ships a tree, not a VRL set.
 constexpr bool usesLightTree(RenderMethod m) {
-    return m == RenderMethod::VrlLightcuts || m == RenderMethod::VplLightcuts;
+    return m == RenderMethod::VrlLightcuts || m == RenderMethod::VrlStochastic || m == RenderMethod::VplLightcuts;
 }
+// The method's parts (c), (d) are Monte Carlo estimates per camera sample (stochastic cuts).
+constexpr bool virtualLightsPerSample(RenderMethod m) { return m == RenderMethod::VrlStochastic; }
 // The method renders the four transport parts with virtual lights (every method but path).
 constexpr bool usesVirtualLights(RenderMethod m) { return m != RenderMethod::Path; }
 
@@ -92,6 +101,7 @@ struct RenderStatistics {
     size_t treeBytes = 0;
     double meanEvaluated = 0.0, meanIntersected = 0.0, meanCutSize = 0.0;  // per pixel, part (d)
     double surfaceMeanEvaluated = 0.0, surfaceMeanIntersected = 0.0, surfaceMeanCutSize = 0.0;  // part (c)
+    double meanImportance = 0.0, surfaceMeanImportance = 0.0;  // vrl-stochastic: importances per pixel and sample
     uint64_t boundExceeded = 0, boundedEstimates = 0;  // inner-node estimates above their bound, (c) and (d)
 };
 

@@ -19,6 +19,9 @@ TransportIntegrator::TransportIntegrator(const Scene& scene, const VrlSet& vrls,
         vplLightcuts_ = std::make_unique<VplLightcutsEstimator>(scene, *tree_, settings.cut, settings.vplDistanceSamples);
     else if (settings.vpls)
         plainVpls_ = std::make_unique<VplEstimator>(scene, vrls.vrls, settings.vplDistanceSamples);
+    else if (tree_ && settings.stochastic)
+        stochastic_ = std::make_unique<StochasticLightcutsEstimator>(scene, *tree_, estimator_, surfaceEstimator_,
+                                                                     settings.cut);
     else if (tree_) {
         lightcuts_ = std::make_unique<LightcutsEstimator>(scene, *tree_, estimator_, settings.cut);
         surfaceLightcuts_ = std::make_unique<SurfaceLightcutsEstimator>(scene, *tree_, surfaceEstimator_, settings.cut);
@@ -123,6 +126,9 @@ TransportIntegrator::VirtualLightParts TransportIntegrator::virtualLightParts(co
             Rng segmentRng = vrlStream(streamKey, ~0u);
             parts.multiple += vplLightcuts_ ? vplLightcuts_->estimate(segment, segmentRng, statistics)
                                             : plainVpls_->estimate(segment, segmentRng);
+        } else if (stochastic_) {
+            Rng segmentRng = vrlStream(streamKey, ~0u);
+            parts.multiple += stochastic_->estimate(segment, segmentRng, statistics);
         } else if (lightcuts_) {
             parts.multiple += lightcuts_->estimate(segment, streamKey, statistics);
         } else {
@@ -144,6 +150,10 @@ Rgb TransportIntegrator::vrlLitSurface(const CameraPathSurface& x, uint64_t stre
                                        float otherLuminance) const {
     if (settings_.maxDepth >= 0 && settings_.maxDepth < x.specularBefore + 3) return Rgb(0.0f);
     if (surfaceLightcuts_) return surfaceLightcuts_->estimate(x, streamKey, statistics, otherLuminance);
+    if (stochastic_) {
+        Rng rng = vrlStream(streamKey, ~0u);
+        return stochastic_->estimate(x, rng, statistics);
+    }
     Rgb sum(0.0f);
     const auto& vrls = tree_ ? tree_->vrls() : vrls_.vrls;
     for (uint32_t k = 0; k < vrls.size(); ++k) {

@@ -14,11 +14,12 @@
 //       sampled in proportion to transmittance, a direction by the phase
 //       function, path-traced from the surface it reaches, no emission there);
 //   (c) x1 on a surface, x2 in a medium: VRL-lit surfaces: every VRL
-//       (VrlSurfaceEstimator) or a cut through the VRL tree (surface_vrl_cut.h)
-//       at x1; the VPL methods path-trace it (their lights are points);
-//   (d) x1 and x2 in media: every VRL (--method vrl) or a cut (vrl-lightcuts)
-//       against each camera segment, or VPLs gathered at distance samples
-//       (vpl, vpl-lightcuts).
+//       (VrlSurfaceEstimator), a cut through the VRL tree (surface_vrl_cut.h)
+//       or a stochastic cut (stochastic_vrl_cut.h) at x1; the VPL methods
+//       path-trace it (their lights are points);
+//   (d) x1 and x2 in media: every VRL (--method vrl), a cut (vrl-lightcuts) or
+//       a stochastic cut (vrl-stochastic) against each camera segment, or VPLs
+//       gathered at distance samples (vpl, vpl-lightcuts).
 // The four sets are disjoint and cover every path, so the parts add up to the
 // reference path tracer's image. Camera paths continue through purely specular
 // surfaces (camera_segment.h): parts (b)-(d) shade every medium segment of that
@@ -31,6 +32,7 @@
 #include "render/integrators/transport_parts.h"
 #include "render/lightcuts/light_tree.h"
 #include "render/lightcuts/vpl_cut.h"
+#include "render/lightcuts/stochastic_vrl_cut.h"
 #include "render/lightcuts/surface_vrl_cut.h"
 #include "render/lightcuts/vrl_cut.h"
 #include "render/vrl/vrl.h"
@@ -50,6 +52,8 @@ struct TransportIntegratorSettings {
     // The lights are VPLs: (d) is VPL Lightcuts over the tree, or plain VPLs without one.
     bool vpls = false;
     int vplDistanceSamples = 32;  // distance samples per camera segment (VPLs)
+    // With a tree: (c), (d) by stochastic cuts (stochastic_vrl_cut.h) of cut.stochasticCutSize nodes.
+    bool stochastic = false;
 };
 
 class TransportIntegrator {
@@ -75,6 +79,9 @@ public:
 
     // Part (c) is estimated from VRLs (not path-sampled).
     bool vrlLitSurfaces() const { return !settings_.vpls; }
+    // The virtual-light parts are themselves Monte Carlo estimates to average over
+    // the camera samples (stochastic cuts), not computed once per pixel.
+    bool virtualLightsPerSample() const { return stochastic_ != nullptr; }
 
 private:
     Rgb singleScattering(const CameraSegment& segment, Rng& rng) const;
@@ -91,6 +98,7 @@ private:
     const LightTree* tree_;
     std::unique_ptr<LightcutsEstimator> lightcuts_;
     std::unique_ptr<SurfaceLightcutsEstimator> surfaceLightcuts_;
+    std::unique_ptr<StochasticLightcutsEstimator> stochastic_;
     std::unique_ptr<VplLightcutsEstimator> vplLightcuts_;
     std::unique_ptr<VplEstimator> plainVpls_;
 };

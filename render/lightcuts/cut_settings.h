@@ -16,6 +16,7 @@ struct ClusterBoundSettings {
 struct CutSettings {
     float errorThreshold = 0.02f;
     uint32_t maxCutSize = 4096;
+    uint32_t stochasticCutSize = 32;  // vrl-stochastic: nodes per cut (K), one VRL drawn under each
     ClusterBoundSettings bound;
 };
 
@@ -26,10 +27,12 @@ struct CutStatistics {
     uint32_t cutSize = 0;      // nodes in the final cut
     uint32_t boundExceeded = 0;  // inner-node estimates above their bound (HG media; 0 if isotropic)
     uint32_t boundedEstimates = 0;  // inner-node estimates checked against their bound
+    uint32_t importanceEvaluations = 0;  // stochastic cuts: node importances computed (cut and descents)
 
     CutStatistics& operator+=(const CutStatistics& o) {
         evaluated += o.evaluated, intersected += o.intersected, cutSize += o.cutSize;
         boundExceeded += o.boundExceeded, boundedEstimates += o.boundedEstimates;
+        importanceEvaluations += o.importanceEvaluations;
         return *this;
     }
 };

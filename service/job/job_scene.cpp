@@ -76,6 +76,7 @@ v1::RenderParameters defaultRenderParameters(RenderMethod method) {
     p.set_exact_distance_below(d.cut.bound.exactDistanceBelow);
     p.set_hg_epsilon(d.cut.bound.anisotropyEpsilon);
     p.set_partition_size(d.partitionSize);
+    p.set_cut_size(d.cut.stochasticCutSize);
     return p;
 }
 
@@ -114,6 +115,9 @@ void validateJobSpec(const v1::JobSpec& spec, const ServiceLimits& limits) {
     if (p.max_cut() < 1 || p.max_cut() > (1u << 30))
         throw JobSpecError("the maximum cut size must be in 1..." + std::to_string(1u << 30) + ", got " +
                            std::to_string(p.max_cut()));
+    if (p.cut_size() > (1u << 20))
+        throw JobSpecError("the stochastic cut size must be in 1..." + std::to_string(1u << 20) +
+                           " (0: the default), got " + std::to_string(p.cut_size()));
     if (p.exact_distance_below() > (1u << 20))
         throw JobSpecError("exact distance below must be in 0..." + std::to_string(1u << 20) + ", got " +
                            std::to_string(p.exact_distance_below()));
@@ -198,6 +202,7 @@ ResolvedJob resolveJob(const std::filesystem::path& sceneFile, const v1::JobSpec
     s.cut.bound.exactDistanceBelow = p.exact_distance_below();
     s.cut.bound.anisotropyEpsilon = p.hg_epsilon();
     s.partitionSize = p.partition_size();
+    if (p.cut_size() > 0) s.cut.stochasticCutSize = p.cut_size();
     validateRenderSettings(s);
     return job;
 }

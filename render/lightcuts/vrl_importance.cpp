@@ -1,0 +1,91 @@
+#include "render/lightcuts/vrl_importance.h"
+
+#include "render/core/distance.h"
+#include "render/scene/scene.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace vrl {
+
+namespace {
+
+// The box's diagonal, and a floor for distances at the scale of the coordinates.
+double diagonal(const Imath::Box3f& box) { return double((box.max - box.min).length()); }
+double tinyDistance(const Vec3& p, const Imath::Box3f& box) {
+    const double reach = std::max({std::abs(box.min.x), std::abs(box.min.y), std::abs(box.min.z),
+                                   std::abs(box.max.x), std::abs(box.max.y), std::abs(box.max.z)});
+    return 1e-6 * (1.0 + double(p.length()) + reach);
+}
+
+// Largest and smallest of n.(q - x) over the box (as surface_cluster_bound.cpp).
+std::pair<double, double> linearRange(const Imath::Box3f& box, const Vec3& n, const Vec3& x) {
+    double centre = 0.0, radius = 0.0;
+    for (int a = 0; a < 3; ++a) {
+        centre += double(n[a]) * (0.5 * (double(box.min[a]) + double(box.max[a])) - double(x[a]));
+        radius += std::abs(double(n[a])) * 0.5 * (double(box.max[a]) - double(box.min[a]));
+    }
+    return {centre - radius, centre + radius};
+}
+
+double largestChannel(const Rgb& c) { return double(std::max({c.x, c.y, c.z})); }
+
+}  // namespace
+
+VrlImportance::VrlImportance(const Scene& scene, const LightTree& tree, float minimumDistanceFraction)
+    : scene_(scene), tree_(tree), fraction_(minimumDistanceFraction) {
+    for (const auto& m : scene.media())
+        for (int c = 0; c < 3; ++c) maxSigmaS_[c] = std::max(maxSigmaS_[c], m.sigmaS()[c]);
+}
+
+double VrlImportance::weight(const LightTreeNode& node) const {
+    const Rgb sigmaS = node.medium >= 0 ? scene_.media()[node.medium].sigmaS() : maxSigmaS_;
+    return double(luminance(node.fluxLength * sigmaS));
+}
+
+double VrlImportance::segment(int32_t index, const CameraSegment& segment) const {
+    const LightTreeNode& node = tree_.nodes()[index];
+    const double w = weight(node);
+    if (!(w > 0.0)) return 0.0;
+    const double hBox = distanceLineBox(segment.origin, segment.direction, node.box);
+    const double h = std::max({hBox, double(fraction_) * diagonal(node.box), tinyDistance(segment.origin, node.box)});
+    // The box's projection onto the line, and the foot point nearest the segment's middle.
+    const Vec3 centre = node.box.center();
+    const Vec3 half = (node.box.max - node.box.min) * 0.5f;
+    const double tc = double(segment.direction.dot(centre - segment.origin));
+    const double r = std::abs(double(segment.direction.x)) * half.x + std::abs(double(segment.direction.y)) * half.y +
+                     std::abs(double(segment.direction.z)) * half.z;
+    const double S = double(segment.length);
+    const double t = std::clamp(0.5 * S, tc - r, tc + r);
+    const double angle = std::atan((S - t) / h) + std::atan(t / h);
+    double transmittance = 1.0;
+    const HomogeneousMedium& medium = scene_.media()[segment.medium];
+    if (node.medium == segment.medium && medium.boundaryConvex())
+        transmittance = largestChannel(medium.transmittance(float(hBox)));
+    return w * transmittance * std::max(angle, 0.0) / h;
+}
+
+double VrlImportance::surface(int32_t index, const CameraPathSurface& x) const {
+    const LightTreeNode& node = tree_.nodes()[index];
+    const double w = weight(node);
+    if (!(w > 0.0)) return 0.0;
+    const Vec3& p = x.hit.position;
+    const SceneShape& shape = scene_.shapes()[x.hit.shape];
+    const bool reflectsOnly = shape.bsdf.kind() != BsdfDescription::Kind::RoughDielectric;
+    const double tiny = tinyDistance(p, node.box);
+    const float side = x.wo.dot(x.hit.geometricNormal) >= 0.0f ? 1.0f : -1.0f;
+    // Wholly behind a reflecting surface (with the bound's rounding slack): exactly 0.
+    if (reflectsOnly && linearRange(node.box, x.hit.geometricNormal * side, p).second < -8.0 * tiny) return 0.0;
+    const double dBox = distancePointBox(p, node.box);
+    const double d = std::max({dBox, double(fraction_) * diagonal(node.box), tiny});
+    const auto [lo, hi] = linearRange(node.box, x.hit.shadingNormal, p);
+    const double cosine = std::clamp(std::max(std::abs(lo), std::abs(hi)) / std::max(dBox, tiny), 1e-3, 1.0);
+    double transmittance = 1.0;
+    if (node.medium >= 0 && node.medium == x.medium && reflectsOnly && !shape.changesMedium) {
+        const HomogeneousMedium& medium = scene_.media()[node.medium];
+        if (medium.boundaryConvex()) transmittance = largestChannel(medium.transmittance(float(dBox)));
+    }
+    return w * cosine * transmittance / (d * d);
+}
+
+}  // namespace vrl

@@ -1,0 +1,361 @@
+// Tests of stochastic VRL Lightcuts (stochastic_cut.h, vrl_importance.h,
+// stochastic_vrl_cut.h): unbiased against plain VRLs over the same VRL set.
+//
+// Reachability: for random trees and random camera segments (lines through
+// node boxes, along a VRL's own line, starting inside the VRLs' region) and
+// surface points, the exact path probability of every VRL under the chosen
+// cut is computed; every VRL with non-zero flux and length has P > 0 for
+// segments, and every VRL with P = 0 gives exactly 0 in 4 (segment) or 16
+// (surface) samples (zero flux or length, or behind the surface); the
+// probabilities sum to the cut's size (relative 1e-9: double rounding only).
+//
+// Unbiasedness, per query: one segment or surface point, the mean of 4,000
+// stochastic estimates (cut size 8) against the mean of 64 plain sums over
+// every VRL (each VRL's own one-sample estimator), within 4.5 combined
+// standard errors (about 130 comparisons, fixed seeds: P(|z| > 4.5) = 7e-6 each
+// for Gaussian means).
+//
+// Unbiasedness, per image: the renderer with one VRL set (traced once) and 64
+// camera seeds for vrl-stochastic (8 for plain vrl, whose noise is a tenth of
+// it), parts (c) and (d), image and 8x8 block means, in grey, chromatic and
+// HG g = 0.7 media, with surfaces (the lit room) and without (the medium cube);
+// within 5 combined standard errors of the seed means (Student t with 63 dof
+// for the dominant term, P(|t| > 5) = 5e-6 each).
+#include "render/lightcuts/stochastic_cut.h"
+#include "render/lightcuts/stochastic_vrl_cut.h"
+#include "render/lightcuts/vrl_importance.h"
+#include "render/renderer.h"
+#include "render/scene/scene.h"
+#include "render/vrl/vrl_estimator.h"
+#include "render/vrl/vrl_surface_estimator.h"
+#include "tests/support/test_scenes.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+
+namespace vrl {
+namespace {
+
+struct MediumCase {
+    const char* name;
+    Rgb sigmaS, sigmaA;
+    float g;
+};
+const MediumCase kMedia[] = {{"grey", Rgb(0.8f), Rgb(0.2f), 0.0f},
+                             {"chromatic", Rgb(0.4f, 0.8f, 1.4f), Rgb(0.2f, 0.1f, 0.05f), 0.0f},
+                             {"hg0.7", Rgb(0.8f), Rgb(0.2f), 0.7f}};
+
+Vec3 randomDirection(Rng& rng) {
+    const float z = 2 * rng.next() - 1, phi = 6.2831853f * rng.next(), r = std::sqrt(std::max(0.0f, 1 - z * z));
+    return Vec3(r * std::cos(phi), r * std::sin(phi), z);
+}
+
+// A diffuse sphere of radius 1 at the origin in a medium filling the null-bounded
+// cube [-4, 4]^3 (convex: the importance's T_r term is exercised).
+std::unique_ptr<Scene> sphereInBoxedMedium(const MediumCase& m) {
+    SceneDescription d = test::pointLightInInfiniteMedium(Rgb(1.0f), Vec3(0.0f, 3.0f, 0.0f), m.sigmaS, m.sigmaA, m.g);
+    d.sensor.toWorld = Transform::lookAt(Vec3(0, 0, -3.5f), Vec3(0, 0, 0), Vec3(0, 1, 0));
+    ShapeDescription sphere;
+    sphere.kind = ShapeDescription::Kind::Sphere;
+    sphere.radius = 1.0f;
+    sphere.bsdf = test::diffuseBsdf(Rgb(0.7f, 0.5f, 0.3f), false);
+    d.shapes.push_back(sphere);
+    ShapeDescription box;
+    box.kind = ShapeDescription::Kind::Cube;
+    box.toWorld = Transform::scale(Vec3(4.0f));
+    box.bsdf = test::nullBsdf();
+    box.interiorMedium = 0;
+    d.shapes.push_back(box);
+    return Scene::build(d);
+}
+
+// VRLs in [-3, 3]^3 outside the sphere mostly; every 10th of zero flux, every
+// 7th of zero length, every 5th crossing the sphere's surface.
+std::vector<Vrl> randomVrls(Rng& rng, int count) {
+    std::vector<Vrl> vrls;
+    for (int i = 0; i < count; ++i) {
+        Vrl v;
+        v.medium = 0;
+        v.flux = i % 10 == 3 ? Rgb(0.0f) : Rgb(0.2f + rng.next(), 0.2f + rng.next(), 0.2f + rng.next()) * 1e-2f;
+        v.origin = Vec3(6 * rng.next() - 3, 6 * rng.next() - 3, 6 * rng.next() - 3);
+        v.direction = randomDirection(rng);
+        v.length = i % 7 == 0 ? 0.0f : 0.05f + 1.5f * rng.next();
+        if (i % 5 == 1) {
+            const Vec3 onSphere = randomDirection(rng);
+            v.origin = onSphere * 1.5f;
+            v.direction = -onSphere;
+            v.length = 0.5f;
+        }
+        vrls.push_back(v);
+    }
+    return vrls;
+}
+
+// Camera segments of every kind: generic, through a node's box centre, along a
+// VRL's own line (h = 0 on its whole length), and starting inside the region.
+CameraSegment randomSegment(const LightTree& tree, Rng& rng, int kind) {
+    CameraSegment s;
+    s.medium = 0;
+    s.throughputBefore = Rgb(0.5f + 0.5f * rng.next());
+    if (kind == 0) {
+        s.origin = randomDirection(rng) * 3.9f;
+        s.direction = (Vec3(2 * rng.next() - 1, 2 * rng.next() - 1, 2 * rng.next() - 1) - s.origin).normalized();
+    } else if (kind == 1) {
+        const auto& node = tree.nodes()[size_t(rng.nextUint() % tree.nodes().size())];
+        s.origin = randomDirection(rng) * 3.9f;
+        s.direction = (node.box.center() - s.origin).normalized();
+    } else if (kind == 2) {
+        const Vrl& v = tree.vrls()[size_t(rng.nextUint() % tree.vrls().size())];
+        s.origin = v.origin - v.direction * 0.5f;
+        s.direction = v.direction;
+    } else {
+        s.origin = Vec3(2 * rng.next() - 1, 2 * rng.next() - 1, 2 * rng.next() - 1) * 2.5f;
+        s.direction = randomDirection(rng);
+    }
+    s.length = 0.5f + 6.0f * rng.next();
+    return s;
+}
+
+std::optional<CameraPathSurface> randomSurfacePoint(const Scene& scene, Rng& rng) {
+    const Vec3 eye = randomDirection(rng) * (1.2f + 2.0f * rng.next());
+    const Vec3 target = randomDirection(rng) * 0.9f;
+    const Vec3 dir = (target - eye).normalized();
+    const auto hit = scene.intersect(Ray{eye, dir});
+    if (!hit) return std::nullopt;
+    return CameraPathSurface{*hit, -dir, 0, Rgb(0.3f + 0.7f * rng.next()), 0};
+}
+
+double channelSum(const Rgb& c) { return double(c.x) + c.y + c.z; }
+
+TEST(StochasticCut, EveryContributingVrlIsReachableAndProbabilitiesSumToTheCutSize) {
+    uint64_t queries = 0, leavesChecked = 0, zeroProbability = 0;
+    for (const MediumCase& m : kMedia) {
+        const auto scene = sphereInBoxedMedium(m);
+        Rng rng(11, uint64_t(&m - kMedia));
+        const LightTree tree = LightTree::build(randomVrls(rng, 700), LightTreeSettings{128, 3});
+        const VrlImportance importance(*scene, tree);
+        const VrlSurfaceEstimator surfaceEstimator(*scene, 1);
+        const VrlEstimator estimator(*scene, 1);
+        for (const uint32_t cutSize : {1u, 8u, 64u}) {
+            for (int q = 0; q < 24; ++q) {
+                const CameraSegment segment = randomSegment(tree, rng, q % 4);
+                const auto p = stochasticLeafProbabilities(
+                    tree, cutSize, [&](int32_t n) { return importance.segment(n, segment); });
+                const auto cut = stochasticCut(tree, cutSize, [&](int32_t n) { return importance.segment(n, segment); });
+                double sum = 0.0;
+                for (size_t k = 0; k < p.size(); ++k) {
+                    sum += p[k];
+                    ++leavesChecked;
+                    const Vrl& vrl = tree.vrls()[k];
+                    if (channelSum(vrl.flux) > 0.0 && vrl.length > 0.0f) {
+                        EXPECT_GT(p[k], 0.0) << m.name << " segment " << q << " VRL " << k;
+                    }
+                    if (p[k] > 0.0) continue;
+                    ++zeroProbability;
+                    for (int s = 0; s < 4; ++s) {  // unreachable: it must give nothing
+                        Rng sample(uint64_t(q), uint64_t(k * 16 + s));
+                        EXPECT_EQ(channelSum(estimator.contribution(vrl, segment, sample)), 0.0)
+                            << m.name << " segment " << q << " VRL " << k;
+                    }
+                }
+                EXPECT_NEAR(sum, double(cut.size()), 1e-9 * double(cut.size())) << m.name << " segment " << q;
+                EXPECT_EQ(cut.size(), std::min<size_t>(cutSize, tree.vrls().size()));
+                ++queries;
+
+                const auto x = randomSurfacePoint(*scene, rng);
+                if (!x) continue;
+                const auto ps = stochasticLeafProbabilities(
+                    tree, cutSize, [&](int32_t n) { return importance.surface(n, *x); });
+                sum = 0.0;
+                for (size_t k = 0; k < ps.size(); ++k) {
+                    sum += ps[k];
+                    ++leavesChecked;
+                    if (ps[k] > 0.0) continue;
+                    ++zeroProbability;
+                    for (int s = 0; s < 16; ++s) {  // unreachable: it must give nothing
+                        Rng sample(uint64_t(q), uint64_t(k * 16 + s));
+                        EXPECT_EQ(channelSum(surfaceEstimator.contribution(tree.vrls()[k], *x, sample)), 0.0)
+                            << m.name << " surface point " << q << " VRL " << k;
+                    }
+                }
+                const auto cutS = stochasticCut(tree, cutSize, [&](int32_t n) { return importance.surface(n, *x); });
+                EXPECT_NEAR(sum, double(cutS.size()), 1e-9 * double(cutS.size())) << m.name << " surface " << q;
+                ++queries;
+            }
+        }
+    }
+    std::printf("%llu queries, %llu (VRL, query) pairs, %llu unreachable (zero flux or length, or behind the "
+                "surface; each checked to give 0)\n",
+                (unsigned long long)queries, (unsigned long long)leavesChecked, (unsigned long long)zeroProbability);
+    EXPECT_GT(zeroProbability, 0u) << "no VRL behind a surface point: the zero-importance case is not exercised";
+}
+
+struct MeanAndError {
+    Rgb mean{0.0f}, standardError{0.0f};
+};
+
+template <class Draw>
+MeanAndError meanOf(int n, Draw&& draw) {
+    double sum[3] = {0, 0, 0}, sum2[3] = {0, 0, 0};
+    for (int i = 0; i < n; ++i) {
+        const Rgb v = draw(i);
+        for (int c = 0; c < 3; ++c) sum[c] += v[c], sum2[c] += double(v[c]) * v[c];
+    }
+    MeanAndError r;
+    for (int c = 0; c < 3; ++c) {
+        const double mean = sum[c] / n;
+        r.mean[c] = float(mean);
+        r.standardError[c] = float(std::sqrt(std::max(0.0, sum2[c] / n - mean * mean) / (n - 1)));
+    }
+    return r;
+}
+
+void expectSameMean(const MeanAndError& a, const MeanAndError& b, const std::string& what) {
+    for (int c = 0; c < 3; ++c) {
+        const double se = std::hypot(a.standardError[c], b.standardError[c]);
+        EXPECT_NEAR(a.mean[c], b.mean[c], 4.5 * se + 1e-12) << what << " channel " << c;
+    }
+}
+
+TEST(StochasticLightcuts, EachQueryMatchesPlainVrlsInExpectation) {
+    int compared = 0;
+    for (const MediumCase& m : kMedia) {
+        const auto scene = sphereInBoxedMedium(m);
+        Rng rng(21, uint64_t(&m - kMedia));
+        const LightTree tree = LightTree::build(randomVrls(rng, 300), LightTreeSettings{64, 5});
+        const VrlEstimator estimator(*scene, 1);
+        const VrlSurfaceEstimator surfaceEstimator(*scene, 1);
+        CutSettings settings;
+        settings.stochasticCutSize = 8;
+        const StochasticLightcutsEstimator stochastic(*scene, tree, estimator, surfaceEstimator, settings);
+        for (int q = 0; q < 8; ++q) {
+            const CameraSegment segment = randomSegment(tree, rng, q % 4);
+            CutStatistics statistics;
+            const MeanAndError cut = meanOf(4000, [&](int i) {
+                Rng r(1000 + q, uint64_t(i));
+                return stochastic.estimate(segment, r, statistics);
+            });
+            const MeanAndError plain = meanOf(64, [&](int i) {
+                Rgb sum(0.0f);
+                for (size_t k = 0; k < tree.vrls().size(); ++k) {
+                    Rng r(2000 + q, uint64_t(i) * 4096 + k);
+                    sum += estimator.contribution(tree.vrls()[k], segment, r);
+                }
+                return sum;
+            });
+            EXPECT_EQ(statistics.evaluated, 4000u * 8u);
+            expectSameMean(cut, plain, std::string(m.name) + " segment " + std::to_string(q));
+            if (q == 0)
+                std::printf("%s segment 0: stochastic %.5g +- %.2g, plain %.5g +- %.2g (green)\n", m.name, cut.mean.y,
+                            cut.standardError.y, plain.mean.y, plain.standardError.y);
+            ++compared;
+
+            const auto x = randomSurfacePoint(*scene, rng);
+            if (!x) continue;
+            const MeanAndError cutS = meanOf(4000, [&](int i) {
+                Rng r(3000 + q, uint64_t(i));
+                return stochastic.estimate(*x, r, statistics);
+            });
+            const MeanAndError plainS = meanOf(64, [&](int i) {
+                Rgb sum(0.0f);
+                for (size_t k = 0; k < tree.vrls().size(); ++k) {
+                    Rng r(4000 + q, uint64_t(i) * 4096 + k);
+                    sum += surfaceEstimator.contribution(tree.vrls()[k], *x, r);
+                }
+                return sum;
+            });
+            expectSameMean(cutS, plainS, std::string(m.name) + " surface point " + std::to_string(q));
+            ++compared;
+        }
+    }
+    std::printf("%d queries compared\n", compared);
+    EXPECT_GE(compared, 40);
+}
+
+// --- The whole image: one VRL set, 64 camera seeds --------------------------
+
+constexpr int kSeeds = 64, kPlainSeeds = 8;
+constexpr int kBlock = 8;
+
+std::vector<Rgb> blockMeans(const Image& image) {
+    std::vector<Rgb> means;
+    for (int by = 0; by < image.height(); by += kBlock)
+        for (int bx = 0; bx < image.width(); bx += kBlock) {
+            Rgb sum(0.0f);
+            for (int y = by; y < std::min(by + kBlock, image.height()); ++y)
+                for (int x = bx; x < std::min(bx + kBlock, image.width()); ++x) sum += image.at(x, y);
+            means.push_back(sum / float(kBlock * kBlock));
+        }
+    Rgb all(0.0f);
+    for (const auto& p : image.pixels()) all += p;
+    means.push_back(all / float(image.pixelCount()));
+    return means;
+}
+
+// Image and block means over the seeds, with their standard errors, of `method`
+// over the VRLs of `lights`.
+std::vector<MeanAndError> overSeeds(const Scene& scene, RenderSettings settings, const RenderLights& lights,
+                                    int seeds) {
+    std::vector<std::vector<Rgb>> runs;
+    const TileRect whole{0, 0, scene.camera().width(), scene.camera().height()};
+    for (int s = 0; s < seeds; ++s) {
+        settings.seed = uint64_t(100 + s);
+        const TileShader shader(scene, settings, lights);
+        runs.push_back(blockMeans(shader.renderTile(whole).layers[0]));
+    }
+    std::vector<MeanAndError> out;
+    for (size_t i = 0; i < runs[0].size(); ++i)
+        out.push_back(meanOf(seeds, [&](int s) { return runs[size_t(s)][i]; }));
+    return out;
+}
+
+void expectImagesAgree(const std::vector<MeanAndError>& a, const std::vector<MeanAndError>& b, const std::string& what) {
+    for (size_t i = 0; i < a.size(); ++i)
+        for (int c = 0; c < 3; ++c) {
+            const double se = std::hypot(a[i].standardError[c], b[i].standardError[c]);
+            EXPECT_NEAR(a[i].mean[c], b[i].mean[c], 5.0 * se + 1e-7)
+                << what << (i + 1 == a.size() ? ": image" : ": block ") << i << " channel " << c;
+        }
+    const MeanAndError& image = a.back();
+    std::printf("%s: image mean (green) stochastic %.5f +- %.5f, plain %.5f +- %.5f\n", what.c_str(), image.mean.y,
+                image.standardError.y, b.back().mean.y, b.back().standardError.y);
+    EXPECT_GT(b.back().mean.y, 0.0f) << what;
+    EXPECT_LT(image.standardError.y, 0.03f * b.back().mean.y) << what << ": too noisy to mean much";
+}
+
+void expectStochasticMatchesPlain(const Scene& scene, const std::string& transports, const std::string& what) {
+    RenderSettings settings;
+    settings.method = RenderMethod::VrlStochastic;
+    settings.transports = TransportSelection::parse(transports);
+    settings.vrlCount = 2000;
+    settings.seed = 7;
+    settings.samplesPerPixel = 4;
+    settings.cut.stochasticCutSize = 16;
+    const RenderLights tree = prepareLights(scene, settings);
+    ASSERT_FALSE(tree.tree.empty());
+    RenderLights plainLights;
+    plainLights.vrls.vrls = tree.tree.vrls();
+    RenderSettings plain = settings;
+    plain.method = RenderMethod::Vrl;
+    plain.samplesPerPixel = 1;
+    expectImagesAgree(overSeeds(scene, settings, tree, kSeeds), overSeeds(scene, plain, plainLights, kPlainSeeds), what);
+}
+
+TEST(StochasticLightcuts, ImageMatchesPlainVrlsOverTheSameVrlSetWithoutSurfaces) {
+    for (const MediumCase& m : kMedia) {
+        const auto scene = Scene::build(test::mediumOnlyCube(m.sigmaS, m.sigmaA, m.g));
+        expectStochasticMatchesPlain(*scene, "multiple", std::string(m.name) + " medium cube (d)");
+    }
+}
+
+TEST(StochasticLightcuts, ImageMatchesPlainVrlsOverTheSameVrlSetWithSurfaces) {
+    for (const MediumCase& m : kMedia) {
+        const auto scene = Scene::build(test::litRoomWithOccluder(m.sigmaS * 0.5f, m.sigmaA * 0.5f, m.g));
+        expectStochasticMatchesPlain(*scene, "medium-surface,multiple", std::string(m.name) + " lit room (c)+(d)");
+    }
+}
+
+}  // namespace
+}  // namespace vrl
