@@ -57,12 +57,34 @@ double VrlImportance::segment(int32_t index, const CameraSegment& segment) const
                      std::abs(double(segment.direction.z)) * half.z;
     const double S = double(segment.length);
     const double t = std::clamp(0.5 * S, tc - r, tc + r);
-    const double angle = std::atan((S - t) / h) + std::atan(t / h);
+    const double thetaB = std::atan((S - t) / h), thetaA = -std::atan(t / h);
+    const double angle = thetaB - thetaA;
     double transmittance = 1.0;
     const HomogeneousMedium& medium = scene_.media()[segment.medium];
     if (node.medium == segment.medium && medium.boundaryConvex())
         transmittance = largestChannel(medium.transmittance(float(hBox)));
-    return w * transmittance * std::max(angle, 0.0) / h;
+    return w * transmittance * std::max(angle, 0.0) / h *
+           phaseFactor(index, segment, centre, t + h * std::tan(0.5 * (thetaA + thetaB)));
+}
+
+double VrlImportance::phaseFactor(int32_t index, const CameraSegment& segment, const Vec3& centre, double u) const {
+    const LightTreeNode& node = tree_.nodes()[index];
+    // Henyey-Greenstein media: the phase functions towards the point u of the camera
+    // line in the middle of the subtended angle, relative to isotropic (4 pi)^2 f f:
+    // the camera side for every node whose box is small seen from there, the VRL side
+    // for single VRLs (an inner node's VRL directions are unknown: isotropic).
+    const HomogeneousMedium& cameraMedium = scene_.media()[segment.medium];
+    const HomogeneousMedium* vrlMedium = node.medium >= 0 ? &scene_.media()[node.medium] : nullptr;
+    const bool anisotropic = !cameraMedium.phase().isIsotropic() || !vrlMedium || !vrlMedium->phase().isIsotropic();
+    if (!anisotropic) return 1.0;
+    const Vec3 toU = segment.origin + segment.direction * float(u) - centre;
+    const float distance = toU.length();
+    const float radius = 0.5f * (node.box.max - node.box.min).length();
+    if (!(distance > 2.0f * radius) || !(distance > 0.0f)) return 1.0;
+    const Vec3 w = toU / distance;
+    double factor = 4.0 * M_PI * double(cameraMedium.phase().eval(w, -segment.direction));
+    if (node.isLeaf() && vrlMedium) factor *= 4.0 * M_PI * double(vrlMedium->phase().eval(tree_.vrls()[size_t(index)].direction, w));
+    return factor;
 }
 
 double VrlImportance::surface(int32_t index, const CameraPathSurface& x) const {
@@ -85,7 +107,15 @@ double VrlImportance::surface(int32_t index, const CameraPathSurface& x) const {
         const HomogeneousMedium& medium = scene_.media()[node.medium];
         if (medium.boundaryConvex()) transmittance = largestChannel(medium.transmittance(float(dBox)));
     }
-    return w * cosine * transmittance / (d * d);
+    // A single VRL in an anisotropic medium: its phase function towards x (4 pi f_V).
+    double phase = 1.0;
+    if (node.isLeaf() && node.medium >= 0 && !scene_.media()[node.medium].phase().isIsotropic()) {
+        const Vrl& vrl = tree_.vrls()[size_t(index)];
+        const Vec3 toX = p - (vrl.origin + vrl.direction * (0.5f * vrl.length));
+        const float length = toX.length();
+        if (length > 0.0f) phase = 4.0 * M_PI * double(scene_.media()[node.medium].phase().eval(vrl.direction, toX / length));
+    }
+    return w * cosine * transmittance * phase / (d * d);
 }
 
 }  // namespace vrl
