@@ -7,6 +7,9 @@
 // threshold, their ratio, the relative RMSE between the two images and #Eval,
 // #Inter and cut size per pixel (the paper's Table 1). Timings are wall-clock,
 // one run each, on whatever cores TBB gets: compare ratios, not seconds.
+// With --build-only it traces and builds the tree only, handing the VRLs over to
+// the build as the renderer does, and prints the process's peak resident set so
+// far (the scale of the tree: 10^7 VRLs and more); -v logs the build's phases.
 #include "render/core/timing.h"
 #include "render/image/image_metrics.h"
 #include "render/integrators/transport_integrator.h"
@@ -17,6 +20,8 @@
 #include "render/vrl/light_tracer.h"
 
 #include <CLI/CLI.hpp>
+#include <spdlog/spdlog.h>
+#include <sys/resource.h>
 #include <tbb/parallel_for.h>
 
 #include <atomic>
@@ -60,6 +65,34 @@ Shading shade(const Scene& scene, const VrlSet& vrls, const LightTree* tree, flo
     return out;
 }
 
+// Peak resident set of this process so far, in MB.
+double peakResidentMb() {
+    rusage usage{};
+    getrusage(RUSAGE_SELF, &usage);
+    return double(usage.ru_maxrss) * 1024.0 / 1e6;
+}
+
+// --build-only: light tracing and the hybrid build, nothing else.
+void buildOnly(const Scene& scene, int maxDepth, const std::vector<uint64_t>& counts) {
+    std::printf("%9s %8s %9s %8s %9s\n", "VRLs", "trace_s", "build_s", "tree_MB", "peak_MB");
+    for (uint64_t n : counts) {
+        LightTracingSettings tracing;
+        tracing.targetVrls = n;
+        tracing.maxDepth = maxDepth;
+        auto start = std::chrono::steady_clock::now();
+        VrlSet vrls = traceVrls(scene, tracing);
+        const double traceSeconds = secondsSince(start);
+        const size_t count = vrls.vrls.size();
+        start = std::chrono::steady_clock::now();
+        const LightTree tree = LightTree::build(std::move(vrls.vrls));
+        const double buildSeconds = secondsSince(start);
+        std::printf("%9zu %8.3f %9.3f %8.1f %9.1f\n", count, traceSeconds, buildSeconds, tree.memoryBytes() / 1e6,
+                    peakResidentMb());
+        std::fflush(stdout);
+    }
+    std::printf("peak_MB: the process's peak resident set so far (getrusage)\n");
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -73,6 +106,7 @@ int main(int argc, char** argv) {
     uint64_t strideAbove = 200000;
     int stride = 4;
     std::vector<std::string> defines;
+    bool buildOnlyMode = false, verbose = false;
     app.add_option("--scene", scenePath, "Scene file (default scenes/smoke-room.xml)");
     app.add_option("-D,--define", defines, "Override a scene <default>: -D name=value (repeatable)");
     app.add_option("--vrls", counts, "VRL counts to run (default 10000 100000 1000000)");
@@ -83,8 +117,11 @@ int main(int argc, char** argv) {
     app.add_option("--stride", stride, "Pixel stride for large N (default 4: 1/16 of the pixels)");
     app.add_option("--part", part, "Transport part: multiple (d, default) or medium-surface (c)")
         ->check(CLI::IsMember({"multiple", "medium-surface"}));
+    app.add_flag("--build-only", buildOnlyMode, "Trace and build the light tree only: build time, tree size, peak memory");
+    app.add_flag("-v,--verbose", verbose, "Log the light tree build's phases (spdlog debug)");
     CLI11_PARSE(app, argc, argv);
     const bool surfacePart = part == "medium-surface";
+    if (verbose) spdlog::set_level(spdlog::level::debug);
 
     ParseOptions parseOptions;
     for (const auto& d : defines) {
@@ -106,6 +143,11 @@ int main(int argc, char** argv) {
     const auto scene = Scene::build(description);
     std::string defined;
     for (const auto& d : defines) defined += " -D " + d;
+    if (buildOnlyMode) {
+        std::printf("scene %s%s, light tree build only\n", scenePath.c_str(), defined.c_str());
+        buildOnly(*scene, description.integrator.maxDepth, counts);
+        return 0;
+    }
     std::printf("scene %s%s, %dx%d, error threshold %.3f, part %s only\n", scenePath.c_str(), defined.c_str(), w, h,
                 error, surfacePart ? "(c) medium-to-surface" : "(d) medium-to-medium");
     std::printf("%9s %8s %9s %8s %9s %10s %9s %9s %8s %9s %8s %8s %8s\n", "VRLs", "trace_s", "build_s", "tree_MB",

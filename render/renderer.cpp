@@ -120,10 +120,10 @@ RenderLights prepareLights(const Scene& scene, const RenderSettings& settings, c
 uint64_t estimateLightMemoryBytes(const RenderSettings& settings) {
     if (!needsLights(settings) || settings.lightPaths > 0) return 0;
     // The light tracer's vector may double while it is filled (2 lights per
-    // light); a tree adds about 2 nodes per light plus its partitioning scratch
-    // (about one more light).
+    // light); a tree takes the lights over and adds 2 nodes per light plus its
+    // build scratch (packed boxes, freed once it is built).
     double perLight = 2.0 * sizeof(Vrl);
-    if (usesLightTree(settings.method)) perLight += 2.0 * sizeof(LightTreeNode) + sizeof(Vrl);
+    if (usesLightTree(settings.method)) perLight += 2.0 * sizeof(LightTreeNode) + double(LightTree::buildScratchBytesPerVrl());
     const double bytes = perLight * double(settings.vrlCount);
     return bytes >= 1.8e19 ? ~uint64_t(0) : uint64_t(bytes);
 }

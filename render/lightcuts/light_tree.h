@@ -10,14 +10,20 @@
 // estimator with flux Phi_C carries the cluster's flux x length), and the
 // longest VRL length L_max.
 //
-// Hybrid build (parallel, deterministic): recursive median splits along the
-// x, y and z axes, keeping at each step the split whose child boxes overlap
-// least, until a partition holds at most `partitionSize` VRLs; heap-based
-// agglomerative clustering in each partition (Walter et al. 2008) merging the
-// pair that minimises I_c E_c^2 (I_c: luminance of the merged flux x length,
-// E_c: diagonal of the merged box); then the partition roots are merged by the
-// same rule. A global agglomerative build (partitionSize >= N) is the quality
-// baseline.
+// Hybrid build (parallel, deterministic: the same tree for the same input and
+// seed whatever the thread count): recursive median splits along the x, y and
+// z axes, keeping at each step the split whose child boxes overlap least, until
+// a partition holds at most `partitionSize` VRLs; agglomerative clustering in
+// each partition (Walter et al. 2008) merging the pair that minimises
+// I_c E_c^2 (I_c: luminance of the merged flux x length, E_c: diagonal of the
+// merged box), found exactly by the nearest-neighbour chain (the cost is
+// reducible); then the partition roots are merged by the same rule. A global
+// agglomerative build (partitionSize >= N) is the quality baseline.
+// Cost: O(N log N) for the splits (each level a few streaming passes and one
+// selection), O(N partitionSize) for the clustering, O(P^2) for the
+// P <= 2N / partitionSize roots. Memory: the tree (VRLs and 2N - 1 nodes,
+// allocated once) plus buildScratchBytesPerVrl() per VRL while it is built.
+// `lightcuts_bench --build-only --vrls 10000000` times it at scale.
 #pragma once
 
 #include "render/core/rgb.h"
@@ -58,6 +64,8 @@ public:
     LightTree() = default;
     // Builds over `vrls` (copied in). Empty input gives an empty tree.
     static LightTree build(std::vector<Vrl> vrls, const LightTreeSettings& settings = {});
+    // Memory build() needs per VRL beyond the tree it returns (bytes).
+    static size_t buildScratchBytesPerVrl();
     // Reassembles a tree from its parts (deserialisation); throws std::invalid_argument
     // if the structure is inconsistent (bad indices, counts, a cycle).
     static LightTree fromParts(std::vector<Vrl> vrls, std::vector<LightTreeNode> nodes, int32_t root);
