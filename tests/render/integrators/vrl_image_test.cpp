@@ -129,11 +129,14 @@ const MediumCase kMedia[] = {{"grey", Rgb(0.8f), Rgb(0.2f), 0.0f},
                              {"chromatic", Rgb(0.4f, 0.8f, 1.4f), Rgb(0.2f, 0.1f, 0.05f), 0.0f},
                              {"hg0.7", Rgb(0.8f), Rgb(0.2f), 0.7f}};
 
+// Also with stochastic VRL Lightcuts ((c), (d) per camera sample, unbiased).
 TEST(VrlImage, PartsSumToReferenceInMediumOnlyScene) {
     for (const MediumCase& m : kMedia) {
         const auto scene = Scene::build(test::mediumOnlyCube(m.sigmaS, m.sigmaA, m.g));
-        expectAgree(vrlRuns(*scene, "surface,single,medium-surface,multiple", 16, kVrls),
-                    referenceRuns(*scene, kReferenceSpp, false), m.name);
+        const RunStatistics reference = referenceRuns(*scene, kReferenceSpp, false);
+        expectAgree(vrlRuns(*scene, "surface,single,medium-surface,multiple", 16, kVrls), reference, m.name);
+        expectAgree(vrlRuns(*scene, "surface,single,medium-surface,multiple", 16, kVrls, -1, RenderMethod::VrlStochastic),
+                    reference, (std::string(m.name) + " vrl-stochastic").c_str());
     }
 }
 
@@ -195,8 +198,10 @@ TEST(VrlImage, MediumSurfaceEqualsRestrictedReferenceInSharedVolCbox) {
 TEST(VrlImage, PartsSumToReferenceInLitRoomWithOccluder) {
     for (const MediumCase& m : kMedia) {
         const auto scene = Scene::build(test::litRoomWithOccluder(m.sigmaS * 0.5f, m.sigmaA * 0.5f, m.g));
-        expectAgree(vrlRuns(*scene, "surface,single,medium-surface,multiple", 16, kVrls),
-                    referenceRuns(*scene, kReferenceSpp, false), m.name);
+        const RunStatistics reference = referenceRuns(*scene, kReferenceSpp, false);
+        expectAgree(vrlRuns(*scene, "surface,single,medium-surface,multiple", 16, kVrls), reference, m.name);
+        expectAgree(vrlRuns(*scene, "surface,single,medium-surface,multiple", 16, kVrls, -1, RenderMethod::VrlStochastic),
+                    reference, (std::string(m.name) + " vrl-stochastic").c_str());
     }
 }
 
