@@ -44,7 +44,7 @@ class Scene;
 
 class VrlImportance {
 public:
-    static constexpr float kDefaultMinimumDistanceFraction = 0.25f;
+    static constexpr float kDefaultMinimumDistanceFraction = 0.05f;
 
     VrlImportance(const Scene& scene, const LightTree& tree,
                   float minimumDistanceFraction = kDefaultMinimumDistanceFraction);
