@@ -76,6 +76,12 @@ public:
     // Part (c) is estimated from VRLs (not path-sampled).
     bool vrlLitSurfaces() const { return !settings_.vpls; }
 
+    // Whether the renderer evaluates virtualLightParts once per camera sample
+    // (with that sample's random stream and ray, averaged like (a), (b)) rather
+    // than once per pixel (with the pixel's own stream (seed, pixel, ~0), in the
+    // first sample pass only, so (c), (d) do not depend on the sample count).
+    bool virtualLightsPerSample() const { return false; }
+
 private:
     Rgb singleScattering(const CameraSegment& segment, Rng& rng) const;
     Rgb mediumToSurface(const CameraSegment& segment, Rng& rng) const;
