@@ -73,8 +73,9 @@ void validateRenderSettings(const RenderSettings& settings) {
     if (settings.vrlSamples < 1) throw std::invalid_argument("samples per VRL must be at least 1");
     if (!(settings.cut.errorThreshold >= 0.0f)) throw std::invalid_argument("the error threshold must be >= 0");
     if (settings.vplDistanceSamples < 1) throw std::invalid_argument("VPL distance samples must be at least 1");
-    if (!(settings.timeLimitSeconds >= 0.0) || !std::isfinite(settings.timeLimitSeconds))
-        throw std::invalid_argument("the time limit must be a finite number of seconds >= 0 (0: none), got " +
+    if (!(settings.timeLimitSeconds >= 0.0 && settings.timeLimitSeconds <= kMaxTimeLimitSeconds))
+        throw std::invalid_argument("the time limit must be 0 (none) or a number of seconds up to " +
+                                    std::to_string(int64_t(kMaxTimeLimitSeconds)) + ", got " +
                                     std::to_string(settings.timeLimitSeconds));
 }
 

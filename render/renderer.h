@@ -67,6 +67,9 @@ constexpr bool usesLightTree(RenderMethod m) {
 // The method renders the four transport parts with virtual lights (every method but path).
 constexpr bool usesVirtualLights(RenderMethod m) { return m != RenderMethod::Path; }
 
+// The longest time limit a render takes (about 116 days): a guard against typos such as 1e30.
+inline constexpr double kMaxTimeLimitSeconds = 1e7;
+
 struct RenderSettings {
     RenderMethod method = RenderMethod::Path;
     int samplesPerPixel = 1;  // path: per pixel; vrl: for parts (a)-(c); with a time limit: the cap
