@@ -9,7 +9,7 @@
 //     them, and a progressive render that stops after P whole passes holds
 //     exactly the sums of a fixed render of samplesAfter(P, N) samples, bit for bit;
 //   - the service may shade pass p of a tile anywhere and add it to the
-//     tile's sum of passes [0, p) (tile_sums.h).
+//     tile's sum of passes [0, p) (sample_sums.h, server/tile_passes.h).
 // Camera sample s of a pixel draws from its own random stream, keyed by
 // (seed, film pixel, s) (renderer.h), so no sample depends on those before it.
 #pragma once
