@@ -101,10 +101,10 @@ public:
             begin(p.preparing_phase().empty() ? "loading the scene" : p.preparing_phase());
             bar_->update(std::clamp(p.preparing_fraction(), 0.0, 1.0));
         } else if (p.state() == v1::JOB_STATE_RENDERING && p.tiles_total() > 0) {
-            begin("rendering");
+            begin(renderingLabel(p));  // a time-limited job: one bar per pass, as the embedded render shows
             bar_->update(double(p.tiles_done()) / p.tiles_total(), detail(p));
         } else if (p.state() == v1::JOB_STATE_DONE) {
-            if (bar_ && label_ == "rendering") bar_->update(1.0, detail(p));
+            if (bar_ && label_.rfind("rendering", 0) == 0 && p.time_limit_seconds() <= 0.0) bar_->update(1.0, detail(p));
             end(true);
         } else if (ended(p.state())) {
             end(false);
@@ -113,9 +113,17 @@ public:
     void stop() { end(false); }
 
 private:
+    static std::string renderingLabel(const v1::JobProgress& p) {
+        if (p.time_limit_seconds() <= 0.0) return "rendering";
+        return "rendering pass " + std::to_string(p.passes_done() + 1) + " (" + std::to_string(p.passes_done()) +
+               " done, " + std::to_string(p.samples_per_pixel()) + " spp)";
+    }
     static std::string detail(const v1::JobProgress& p) {
         char text[128];
-        if (p.eta_seconds() >= 0 && p.state() == v1::JOB_STATE_RENDERING)
+        if (p.time_limit_seconds() > 0.0 && p.state() == v1::JOB_STATE_RENDERING)
+            std::snprintf(text, sizeof text, "%u/%u tiles, %d workers, %.1f s left", p.tiles_done(), p.tiles_total(),
+                          p.workers_size(), std::max(0.0, p.eta_seconds()));
+        else if (p.eta_seconds() >= 0 && p.state() == v1::JOB_STATE_RENDERING)
             std::snprintf(text, sizeof text, "%u/%u tiles, %d workers, ETA %.1f s", p.tiles_done(), p.tiles_total(),
                           p.workers_size(), p.eta_seconds());
         else
@@ -130,7 +138,7 @@ private:
     }
     void end(bool complete) {
         if (!bar_) return;
-        if (complete && label_ != "rendering") bar_->update(1.0);
+        if (complete && label_.rfind("rendering", 0) != 0) bar_->update(1.0);
         bar_->finish();
         bar_.reset();
         label_.clear();
@@ -224,6 +232,9 @@ int interrupted(JobClient& client, const std::string& jobId, int signal, const R
             std::fprintf(stderr, "vrl: partial image with %.0f of %.0f tiles written to %s (unfinished pixels are 0; "
                                  "layer \"coverage\" marks the finished ones)\n",
                          metadataNumber(done->second), metadataNumber(total->second), o.output.c_str());
+        else if (const auto passes = images.metadata.find("vrl.progressive.passes"); passes != images.metadata.end())
+            std::fprintf(stderr, "vrl: wrote the %.0f completed passes (%.0f spp) to %s\n",
+                         metadataNumber(passes->second), metadataNumber(images.metadata.at("vrl.spp")), o.output.c_str());
         else
             std::fprintf(stderr, "vrl: the whole image was done: written to %s\n", o.output.c_str());
         if (!o.preview.empty()) writePreviewPng(images.image, o.preview, autoExposure(images.image));
@@ -313,9 +324,15 @@ int runRemoteRender(const RenderCommandOptions& o, const RemoteOptions& remote, 
         const ImageSet images = readExr(o.output);
         writePreviewPng(images.image, o.preview, autoExposure(images.image));
     }
+    if (last.time_limit_seconds() > 0.0 && last.passes_done() == 0)
+        std::fprintf(stderr, "vrl: the time limit ran out in the first pass: %s is a partial image (unfinished tiles "
+                             "are 0; see its 'coverage' layer and vrl.partial)\n", o.output.c_str());
     if (o.quiet) return 0;  // -q: warnings and errors only
     std::fprintf(stderr, "summary: job %s, %u tiles, %.3f s in all -> %s\n", jobId.c_str(), last.tiles_total(),
                  secondsSince(start), o.output.c_str());
+    if (last.time_limit_seconds() > 0.0)
+        std::fprintf(stderr, "  progressive: %u passes completed in the %.3g s time limit -> %d spp\n",
+                     last.passes_done(), last.time_limit_seconds(), last.samples_per_pixel());
     for (const auto& phase : last.phases()) std::fprintf(stderr, "  %-18s %8.3f s\n", phase.phase().c_str(), phase.seconds());
     for (const auto& w : last.workers())
         std::fprintf(stderr, "  worker %-16s %6llu tiles, %.3g pixels/s per thread\n", w.worker().c_str(),

@@ -165,11 +165,14 @@ int runRender(const RenderCommandOptions& o, const CLI::App& command) {
         return util::TerminationSignals::exitCode(signals.received());
     }
     if (bar) bar->finish();
+    const bool progressive = settings.timeLimitSeconds > 0.0;
+    const int signal = signals.received();
     if (!coverage.complete()) {
         if (coverage.rowsDone == 0) {
+            // Only a signal stops a render before its first row: a time limit lets the first pass start.
             std::fprintf(stderr, "vrl render: %s before any pixel row was finished: no image written\n",
-                         signalName(signals.received()));
-            return util::TerminationSignals::exitCode(signals.received());
+                         signal ? signalName(signal) : "the time limit ran out");
+            return signal ? util::TerminationSignals::exitCode(signal) : 1;
         }
         markPartial(images, coverage.covered, coverage.tilesDone, coverage.tilesTotal);
     }
@@ -192,9 +195,14 @@ int runRender(const RenderCommandOptions& o, const CLI::App& command) {
         std::fprintf(stderr,
                      "vrl render: %s: stopped; wrote what was finished to %s: %d of %d tiles whole, %.1f%% of the "
                      "pixels (a partial image: unfinished pixels are 0, see its 'coverage' layer and vrl.partial)\n",
-                     signalName(signals.received()), o.output.c_str(), coverage.tilesDone, coverage.tilesTotal,
-                     100.0 * coveredFraction(coverage));
-        return util::TerminationSignals::exitCode(signals.received());
+                     signal ? signalName(signal) : "the time limit ran out in the first pass", o.output.c_str(),
+                     coverage.tilesDone, coverage.tilesTotal, 100.0 * coveredFraction(coverage));
+        return signal ? util::TerminationSignals::exitCode(signal) : 0;
+    }
+    if (signal && progressive) {  // stopped between passes: its completed passes are a whole image
+        std::fprintf(stderr, "vrl render: %s: stopped; wrote the %d completed passes (%d spp) to %s\n",
+                     signalName(signal), stats.passes, stats.samplesPerPixel, o.output.c_str());
+        return util::TerminationSignals::exitCode(signal);
     }
     if (o.quiet) return 0;
 
@@ -203,12 +211,15 @@ int runRender(const RenderCommandOptions& o, const CLI::App& command) {
                  "  parse  %8.3f s\n  build  %8.3f s (%zu shapes, %zu media, %zu emitters)\n"
                  "  render %8.3f s (%llu camera samples, %.3g samples/s)\n  write  %8.3f s -> %s\n"
                  "  peak memory %.1f MiB\n",
-                 o.scene.c_str(), scene->camera().width(), scene->camera().height(), std::string(methodName(settings.method)).c_str(), settings.samplesPerPixel,
+                 o.scene.c_str(), scene->camera().width(), scene->camera().height(), std::string(methodName(settings.method)).c_str(), stats.samplesPerPixel,
                  (unsigned long long)settings.seed, threads, parseSeconds, buildSeconds, scene->shapes().size(),
                  scene->media().size(), scene->emitters().size(), stats.seconds,
                  (unsigned long long)stats.cameraSamples,
                  stats.seconds > 0 ? double(stats.cameraSamples) / stats.seconds : 0.0, writeSeconds,
                  o.output.c_str(), peakMemoryMiB());
+    if (progressive)
+        std::fprintf(stderr, "  progressive: %d passes completed in the %.3g s time limit -> %d spp (cap %d)\n",
+                     stats.passes, settings.timeLimitSeconds, stats.samplesPerPixel, settings.samplesPerPixel);
     if (usesVirtualLights(settings.method)) {
         std::fprintf(stderr, "  light tracing %.3f s: %llu light paths -> %llu %s, %.1f MiB (%zu bytes each)\n",
                      stats.tracingSeconds, (unsigned long long)stats.lightPaths, (unsigned long long)stats.vrlCount,

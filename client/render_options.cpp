@@ -6,6 +6,7 @@
 #include <spdlog/spdlog.h>
 
 #include <cerrno>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <regex>
@@ -35,8 +36,27 @@ void addRenderOptions(CLI::App& cmd, RenderCommandOptions& o) {
                     "distance samples per camera segment, (c) path-sampled; vpl: the same with every VPL gathered, no "
                     "tree). No method clamps contributions")
         ->check(CLI::IsMember(renderMethodNames()));
-    cmd.add_option("--spp", o.spp, "Samples per pixel (default: the scene's sampler sampleCount)")
+    cmd.add_option("--spp", o.spp,
+                   "Samples per pixel (default: the scene's sampler sampleCount); with --time-limit, the most "
+                   "samples per pixel to render (default: no cap but the limit)")
         ->check(CLI::Range(1, kMaxSampleCount));
+    cmd.add_option("--time-limit", o.timeLimit,
+                   "Render progressively for about this many seconds (after light preparation): passes of 1, 2, "
+                   "4, ... samples per pixel over the whole image until the limit (or --spp) is reached; the image "
+                   "holds the completed passes (2^P - 1 samples per pixel, bit-identical to --spp 2^P - 1), so it "
+                   "depends on this machine's speed; the passes and samples are recorded in the EXR")
+        ->check(CLI::Validator(
+            [](std::string& value) {
+                char* end = nullptr;
+                errno = 0;
+                const double seconds = std::strtod(value.c_str(), &end);
+                if (value.empty() || end == value.c_str() || *end != '\0' || errno == ERANGE || !std::isfinite(seconds) ||
+                    seconds <= 0.0 || seconds > kMaxTimeLimitSeconds)
+                    return std::string("must be a number of seconds, > 0 and at most ") +
+                           std::to_string(int64_t(kMaxTimeLimitSeconds)) + " (e.g. 60 or 0.5)";
+                return std::string();
+            },
+            "SECONDS"));
     cmd.add_option("--resolution", o.resolution, "Image size WxH, overriding the scene's film (e.g. 640x480)");
     cmd.add_option("--crop", o.crop, "Render only the window x,y,width,height of the film (after --resolution), "
                    "overriding the scene's crop; its pixels equal the full render's (e.g. 16,8,32,24)");
@@ -176,6 +196,7 @@ v1::RenderParameters toRenderParameters(const RenderCommandOptions& o) {
     v1::RenderParameters p;
     p.set_method(o.method);
     p.set_samples_per_pixel(o.spp);
+    p.set_time_limit_seconds(o.timeLimit);
     p.set_seed(o.seed);
     p.set_jitter(!o.pixelCentres);
     p.set_max_depth(o.maxDepth);

@@ -22,7 +22,8 @@ struct RenderCommandOptions {
     std::string medium;   // --medium "sigmaS=..,sigmaA=..[,g=..]": fill a scene without media
     std::string preview;  // --preview out.png: a tone-mapped PNG beside the EXR
     std::string method;  // empty: the scene's <integrator> if it names one of ours, else the headline method
-    int spp = 0;  // 0: the scene's sampleCount
+    int spp = 0;  // 0: the scene's sampleCount (with --time-limit: the cap, 0 none)
+    double timeLimit = 0.0;  // --time-limit SECONDS: > 0 renders progressive passes until then
     std::string resolution;  // "WxH", empty: the scene's film
     std::string crop;        // "x,y,w,h" of the (resolved) film, empty: the scene's crop window if any
     int threads = 0;         // 0: all cores

@@ -167,10 +167,16 @@ void registerServiceCommands(CLI::App& app, int& exitCode) {
                 for (const auto& j : client.list()) {
                     const std::string finished =
                         j.finished_unix_ms() > 0 ? agoText(j.finished_unix_ms()) + " ago" : std::string("-");
-                    std::printf("%-18s %-10s %8d %4u/%-4u  %-19s %9s %-13s %s%s%s\n", j.job_id().c_str(),
+                    // A time-limited job: its passes so far (TILES counts the pass under way).
+                    const std::string passes =
+                        j.time_limit_seconds() > 0.0
+                            ? "  [" + std::to_string(j.passes_done()) + " passes, " +
+                                  std::to_string(j.samples_per_pixel()) + " spp]"
+                            : std::string();
+                    std::printf("%-18s %-10s %8d %4u/%-4u  %-19s %9s %-13s %s%s%s%s\n", j.job_id().c_str(),
                                 stateName(j.state()), j.priority(), j.tiles_done(), j.tiles_total(),
                                 whenText(j.submitted_unix_ms()).c_str(), agoText(j.submitted_unix_ms()).c_str(),
-                                finished.c_str(), j.name().c_str(), j.message().empty() ? "" : "  -- ",
+                                finished.c_str(), j.name().c_str(), passes.c_str(), j.message().empty() ? "" : "  -- ",
                                 j.message().c_str());
                 }
                 return 0;

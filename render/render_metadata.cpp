@@ -12,7 +12,14 @@ void writeRenderMetadata(const RenderRecord& record, const PerspectiveCamera& ca
     metadata["vrl.version"] = std::string(VRL_VERSION);
     metadata["vrl.scene"] = record.scene;
     metadata["vrl.method"] = std::string(methodName(s.method));
-    metadata["vrl.spp"] = int32_t(s.samplesPerPixel);
+    // A progressive render holds the samples of its completed passes; its cap and limit are recorded apart.
+    const bool progressive = s.timeLimitSeconds > 0.0;
+    metadata["vrl.spp"] = int32_t(progressive ? stats.samplesPerPixel : s.samplesPerPixel);
+    if (progressive) {
+        metadata["vrl.progressive.passes"] = int32_t(stats.passes);
+        metadata["vrl.progressive.timeLimit"] = s.timeLimitSeconds;
+        metadata["vrl.progressive.sppCap"] = int32_t(s.samplesPerPixel);
+    }
     metadata["vrl.seed"] = std::to_string(s.seed);
     metadata["vrl.maxDepth"] = int32_t(s.maxDepth);
     metadata["vrl.jitter"] = int32_t(s.jitter ? 1 : 0);

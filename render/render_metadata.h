@@ -10,6 +10,9 @@
 //   vrl.approximations, vrl.ignored                                   string
 //   vrl.seed                                        string (a 64-bit value: no EXR int holds it)
 //   vrl.spp, vrl.maxDepth, vrl.jitter (0/1), vrl.width, vrl.height    int (the image: the crop's size)
+//   progressive renders only (a time limit): vrl.spp is the samples per pixel of the completed
+//     passes (statistics.samplesPerPixel); vrl.progressive.passes, vrl.progressive.sppCap (int:
+//     the completed passes, the cap asked for), vrl.progressive.timeLimit (double seconds)
 //   cropped renders only: vrl.crop ("x0,y0,width,height" in film pixels), vrl.film ("WxH")  string
 //   methods with virtual lights: vrl.transport (string), vrl.vrlSamples (int),
 //     vrl.vrls or vrl.vpls, vrl.lightPaths (double: counts beyond 2^31)

@@ -11,6 +11,7 @@
 #include <algorithm>
 #include <atomic>
 #include <chrono>
+#include <cmath>
 #include <stdexcept>
 
 namespace vrl {
@@ -80,6 +81,10 @@ void validateRenderSettings(const RenderSettings& settings) {
     if (settings.cut.stochasticCutSize < 1 || settings.cut.stochasticCutSize > (1u << 20))
         throw std::invalid_argument("the stochastic cut size must be in [1, 1048576], not " +
                                     std::to_string(settings.cut.stochasticCutSize));
+    if (!(settings.timeLimitSeconds >= 0.0 && settings.timeLimitSeconds <= kMaxTimeLimitSeconds))
+        throw std::invalid_argument("the time limit must be 0 (none) or a number of seconds up to " +
+                                    std::to_string(int64_t(kMaxTimeLimitSeconds)) + ", got " +
+                                    std::to_string(settings.timeLimitSeconds));
 }
 
 RenderLights prepareLights(const Scene& scene, const RenderSettings& settings, const ProgressCallback& progress,
@@ -188,22 +193,73 @@ TileShader::TileShader(const Scene& scene, const RenderSettings& settings, const
         integratorSettings.stochastic = settings.method == RenderMethod::VrlStochastic;
         integrator_ = std::make_unique<TransportIntegrator>(scene, lights.vrls, integratorSettings,
                                                       lightcuts && lights.tree.root() >= 0 ? &lights.tree : nullptr);
+        lightsPerSample_ = integrator_->virtualLightsPerSample();
     } else {
         tracer_ = std::make_unique<VolumetricPathTracer>(scene, PathTracerSettings{settings.maxDepth});
     }
+    // Once per pixel: the virtual-light parts (c) (when by VRLs) and (d), and the cut counters.
+    layerPerPixel_.assign(1 + layerNames_.size(), 0);
+    if (integrator_ && !lightsPerSample_)
+        for (size_t l = 0; l < layerNames_.size(); ++l) {
+            const std::string& name = layerNames_[l];
+            const bool part = std::find(kTransportPartNames.begin(), kTransportPartNames.end(), name) !=
+                              kTransportPartNames.end();
+            const bool virtualLightPart = name == kTransportPartNames[size_t(TransportPart::Multiple)] ||
+                                          (name == kTransportPartNames[size_t(TransportPart::MediumSurface)] &&
+                                           integrator_->vrlLitSurfaces());
+            layerPerPixel_[l + 1] = !part || virtualLightPart;
+        }
 }
 
 TileShader::~TileShader() = default;
 
 TileImages TileShader::renderTile(const TileRect& tile, const RenderStop& stop) const {
+    TileSums shaded = shadeTile(tile, 0, passesFor(settings_.samplesPerPixel), stop);
+    TileImages out;
+    out.layers = resolveSamples(shaded.sums, layerNames_, settings_.samplesPerPixel);
+    out.boundExceeded = shaded.sums.boundExceeded;
+    out.boundedEstimates = shaded.sums.boundedEstimates;
+    out.interrupted = shaded.interrupted;
+    out.rowsDone = shaded.rowsDone;
+    return out;
+}
+
+namespace {
+
+// One pixel's values, one per layer (image first), summed or set by shadeTile.
+using PixelValues = std::vector<Rgb>;
+
+// The cut counters of one evaluation, as layer values.
+// `add`: per camera sample (stochastic cuts), whose middle counter is the
+// importances computed (kStochasticLayerNames) rather than #Inter.
+void writeCounters(PixelValues& values, size_t& layer, const CutStatistics& cut, const CutStatistics& surfaceCut,
+                   bool add) {
+    const auto put = [&](uint64_t count) {
+        Rgb& v = values[layer++];
+        v = add ? v + Rgb(float(count)) : Rgb(float(count));
+    };
+    put(cut.evaluated), put(add ? cut.importanceEvaluations : cut.intersected), put(cut.cutSize);
+    if (layer < values.size())
+        put(surfaceCut.evaluated), put(add ? surfaceCut.importanceEvaluations : surfaceCut.intersected),
+            put(surfaceCut.cutSize);
+}
+
+}  // namespace
+
+TileSums TileShader::shadeTile(const TileRect& tile, int firstPass, int passCount, const RenderStop& stop) const {
     const PerspectiveCamera& camera = scene_.camera();
     if (tile.x0 < 0 || tile.y0 < 0 || tile.x1 > camera.width() || tile.y1 > camera.height() || tile.x0 >= tile.x1 ||
         tile.y0 >= tile.y1)
         throw std::invalid_argument("tile outside the image");
-    const int w = tile.width(), h = tile.height();
-    TileImages out;
-    out.layers.assign(1 + layerNames_.size(), Image(w, h));
-    const float spp = float(settings_.samplesPerPixel);
+    if (firstPass < 0 || passCount < 1 || firstPass > kMaxPasses || (firstPass > 0 && passCount != 1))
+        throw std::invalid_argument("shadeTile: passes [" + std::to_string(firstPass) + ", +" +
+                                    std::to_string(passCount) + ") must start at pass 0 or be a single pass");
+    const int w = tile.width();
+    const size_t layerCount = 1 + layerNames_.size();
+    const bool lightcuts = usesLightTree(settings_.method);
+    TileSums out;
+    out.sums = SampleSums::zeros(w, tile.height(), layerPerPixel_);
+    PixelValues total(layerCount), pass(layerCount);
     for (int y = tile.y0; y < tile.y1; ++y) {
         if (stop()) {
             out.interrupted = true;
@@ -211,60 +267,61 @@ TileImages TileShader::renderTile(const TileRect& tile, const RenderStop& stop) 
             return out;
         }
         for (int x = tile.x0; x < tile.x1; ++x) {
-            Rng rng(settings_.seed, camera.filmPixelIndex(x, y));
-            const int tx = x - tile.x0, ty = y - tile.y0;
-            if (tracer_) {
-                Rgb sum(0.0f);
-                for (int s = 0; s < settings_.samplesPerPixel; ++s)
-                    sum += tracer_->radiance(cameraRay(camera, settings_, x, y, rng), scene_.cameraMedium(), rng);
-                out.layers[0].at(tx, ty) = sum / spp;
-                continue;
-            }
-            std::array<Rgb, 4> parts{Rgb(0.0f), Rgb(0.0f), Rgb(0.0f), Rgb(0.0f)};
-            CutStatistics cut, surfaceCut;
-            const bool perSample = integrator_->virtualLightsPerSample();
-            const auto addVirtualLights = [&](const TransportIntegrator::VirtualLightParts& lit) {
-                if (integrator_->vrlLitSurfaces()) parts[size_t(TransportPart::MediumSurface)] += lit.mediumSurface;
-                parts[size_t(TransportPart::Multiple)] += lit.multiple;
-            };
-            for (int s = 0; s < settings_.samplesPerPixel; ++s) {
-                const Ray ray = cameraRay(camera, settings_, x, y, rng);
-                const auto sample = integrator_->samplePathParts(ray, rng);
-                for (size_t p = 0; p < 4; ++p) parts[p] += sample[p];
-                // Stochastic cuts: (c) and (d) per camera sample, along the same ray.
-                if (perSample) addVirtualLights(integrator_->virtualLightParts(ray, rng, &cut, &surfaceCut));
-            }
-            for (size_t p = 0; p < 4; ++p) parts[p] /= spp;
-            if (!perSample) {
-                // (c) and (d) by VRLs once per pixel: their cost is per VRL, not per camera sample.
-                const float pathLuminance = std::max(0.0f, luminance(parts[0] + parts[1] + parts[2]));
-                addVirtualLights(integrator_->virtualLightParts(cameraRay(camera, settings_, x, y, rng), rng, &cut,
-                                                                &surfaceCut, pathLuminance));
-            }
-            // Counters per pixel and camera sample when (c), (d) are sampled per camera sample.
-            const float counterScale = perSample ? 1.0f / spp : 1.0f;
-            Rgb sum(0.0f);
-            size_t layer = 1;
-            for (size_t p = 0; p < parts.size(); ++p) {
-                if (!settings_.transports.enabled[p]) continue;
-                sum += parts[p];
-                out.layers[layer++].at(tx, ty) = parts[p];
-            }
-            out.layers[0].at(tx, ty) = sum;
-            if (usesLightTree(settings_.method)) {
-                out.layers[layer++].at(tx, ty) = Rgb(float(cut.evaluated) * counterScale);
-                out.layers[layer++].at(tx, ty) =
-                    Rgb(float(perSample ? cut.importanceEvaluations : cut.intersected) * counterScale);
-                out.layers[layer++].at(tx, ty) = Rgb(float(cut.cutSize) * counterScale);
-                if (layer < out.layers.size()) {
-                    out.layers[layer++].at(tx, ty) = Rgb(float(surfaceCut.evaluated) * counterScale);
-                    out.layers[layer++].at(tx, ty) =
-                        Rgb(float(perSample ? surfaceCut.importanceEvaluations : surfaceCut.intersected) * counterScale);
-                    out.layers[layer++].at(tx, ty) = Rgb(float(surfaceCut.cutSize) * counterScale);
+            const uint64_t pixel = camera.filmPixelIndex(x, y);
+            std::fill(total.begin(), total.end(), Rgb(0.0f));
+            float firstSampleLuminance = 0.0f;  // of sample 0's path-sampled parts, for (c)'s cut
+            for (int p = firstPass; p < firstPass + passCount; ++p) {
+                const SamplePass samples = samplePass(p, settings_.samplesPerPixel);
+                if (samples.count == 0) break;
+                std::fill(pass.begin(), pass.end(), Rgb(0.0f));
+                for (int s = samples.first; s < samples.first + samples.count; ++s) {
+                    Rng rng(settings_.seed, Rng::combine(pixel, uint64_t(s)));
+                    const Ray ray = cameraRay(camera, settings_, x, y, rng);
+                    if (tracer_) {
+                        pass[0] += tracer_->radiance(ray, scene_.cameraMedium(), rng);
+                        continue;
+                    }
+                    std::array<Rgb, 4> parts = integrator_->samplePathParts(ray, rng);
+                    const float pathLuminance = std::max(0.0f, luminance(parts[0] + parts[1] + parts[2]));
+                    if (s == 0) firstSampleLuminance = pathLuminance;
+                    CutStatistics cut, surfaceCut;
+                    if (lightsPerSample_) {
+                        const auto lit = integrator_->virtualLightParts(ray, rng, &cut, &surfaceCut, pathLuminance);
+                        if (integrator_->vrlLitSurfaces()) parts[size_t(TransportPart::MediumSurface)] = lit.mediumSurface;
+                        parts[size_t(TransportPart::Multiple)] = lit.multiple;
+                        out.sums.boundExceeded += cut.boundExceeded + surfaceCut.boundExceeded;
+                        out.sums.boundedEstimates += cut.boundedEstimates + surfaceCut.boundedEstimates;
+                    }
+                    size_t layer = 1;
+                    for (size_t part = 0; part < parts.size(); ++part)
+                        if (settings_.transports.enabled[part]) pass[layer++] += parts[part];
+                    if (lightcuts && lightsPerSample_) writeCounters(pass, layer, cut, surfaceCut, true);
                 }
-                out.boundExceeded += cut.boundExceeded + surfaceCut.boundExceeded;
-                out.boundedEstimates += cut.boundedEstimates + surfaceCut.boundedEstimates;
+                // The canonical fold: the first pass's sums as they are, later ones added (per-sample layers only).
+                for (size_t l = 0; l < layerCount; ++l)
+                    if (!layerPerPixel_[l]) total[l] = p == firstPass ? pass[l] : total[l] + pass[l];
+                if (p != 0 || !integrator_ || lightsPerSample_) continue;
+                // (c) and (d) once per pixel, in pass 0, from the pixel's own stream: their cost is per
+                // VRL, not per camera sample. (c)'s cut measures its error against sample 0's other parts.
+                Rng rng(settings_.seed, Rng::combine(pixel, kPixelLightsSample));
+                const Ray ray = cameraRay(camera, settings_, x, y, rng);
+                CutStatistics cut, surfaceCut;
+                const auto lit = integrator_->virtualLightParts(ray, rng, &cut, &surfaceCut, firstSampleLuminance);
+                size_t layer = 1;
+                for (size_t part = 0; part < 4; ++part) {
+                    if (!settings_.transports.enabled[part]) continue;
+                    if (part == size_t(TransportPart::Multiple)) total[layer] = lit.multiple;
+                    if (part == size_t(TransportPart::MediumSurface) && integrator_->vrlLitSurfaces())
+                        total[layer] = lit.mediumSurface;
+                    ++layer;
+                }
+                if (lightcuts) {
+                    writeCounters(total, layer, cut, surfaceCut, false);
+                    out.sums.boundExceeded += cut.boundExceeded + surfaceCut.boundExceeded;
+                    out.sums.boundedEstimates += cut.boundedEstimates + surfaceCut.boundedEstimates;
+                }
             }
+            for (size_t l = 0; l < layerCount; ++l) out.sums.layers[l].at(x - tile.x0, y - tile.y0) = total[l];
         }
     }
     return out;
@@ -303,6 +360,64 @@ ImageSet assembleImageSet(std::vector<Image> layers, const std::vector<std::stri
     return result;
 }
 
+namespace {
+
+// Passes [firstPass, firstPass + passCount) of every tile, in parallel (TBB),
+// into whole-image sums; a tile stopped midway keeps its finished rows.
+struct TilesShaded {
+    SampleSums sums;
+    std::vector<int> tileRows;  // rows shaded per tile
+    int tilesDone = 0;
+};
+TilesShaded shadeTiles(const TileShader& shader, const std::vector<TileRect>& tiles, int width, int height,
+                       int firstPass, int passCount, const RenderStop& stop, const ProgressCallback& progress,
+                       const std::string& phase) {
+    TilesShaded out;
+    out.sums = SampleSums::zeros(width, height, shader.layerPerPixel());
+    out.tileRows.assign(tiles.size(), 0);
+    std::atomic<uint64_t> boundExceeded{0}, boundedEstimates{0};
+    std::atomic<long long> pixelsDone{0};
+    std::atomic<int> tilesDone{0};
+    const double totalPixels = double(width) * height;
+    if (progress) progress(phase.c_str(), 0.0);
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, tiles.size(), 1), [&](const tbb::blocked_range<size_t>& range) {
+        for (size_t t = range.begin(); t < range.end(); ++t) {
+            if (stop()) return;
+            const TileRect& tile = tiles[t];
+            const TileSums shaded = shader.shadeTile(tile, firstPass, passCount, stop);
+            const int rows = shaded.interrupted ? shaded.rowsDone : tile.height();
+            out.tileRows[t] = rows;
+            copyRows(out.sums, shaded.sums, tile.x0, tile.y0, rows);
+            if (shaded.interrupted) return;
+            ++tilesDone;
+            boundExceeded += shaded.sums.boundExceeded;
+            boundedEstimates += shaded.sums.boundedEstimates;
+            const long long count = static_cast<long long>(tile.width()) * tile.height();
+            const long long done = pixelsDone.fetch_add(count) + count;
+            if (progress) progress(phase.c_str(), double(done) / totalPixels);
+        }
+    });
+    out.tilesDone = tilesDone.load();
+    out.sums.boundExceeded = boundExceeded.load();
+    out.sums.boundedEstimates = boundedEstimates.load();
+    return out;
+}
+
+void fillCoverage(RenderCoverage& coverage, const std::vector<TileRect>& tiles, const std::vector<int>& tileRows,
+                  int tilesDone, int width, int height) {
+    coverage.tilesTotal = int(tiles.size());
+    coverage.tilesDone = tilesDone;
+    coverage.rowsDone = 0;
+    coverage.covered.assign(size_t(width) * height, 0);
+    for (size_t t = 0; t < tiles.size(); ++t) {
+        coverage.rowsDone += tileRows[t];
+        for (int y = tiles[t].y0; y < tiles[t].y0 + tileRows[t]; ++y)
+            std::fill_n(&coverage.covered[size_t(y) * width + tiles[t].x0], tiles[t].width(), uint8_t(1));
+    }
+}
+
+}  // namespace
+
 ImageSet render(const Scene& scene, const RenderSettings& settings, const ProgressCallback& progress,
                 RenderStatistics* statistics, const RenderStop& stop, RenderCoverage* coverage) {
     validateRenderSettings(settings);
@@ -319,49 +434,56 @@ ImageSet render(const Scene& scene, const RenderSettings& settings, const Progre
     const auto start = std::chrono::steady_clock::now();
     const TileShader shader(scene, settings, lights);
     const int width = scene.camera().width(), height = scene.camera().height();
-    std::vector<Image> layers(1 + shader.layerNames().size(), Image(width, height));
     const std::vector<TileRect> tiles = imageTiles(width, height, settings.tileSize);
-    std::atomic<uint64_t> boundExceeded{0}, boundedEstimates{0};
-    std::atomic<long long> pixelsDone{0};
-    std::atomic<int> tilesDone{0};
-    std::vector<int> tileRows(tiles.size(), 0);  // rows shaded per tile
-    const double totalPixels = double(width) * height;
-    if (progress) progress("rendering", 0.0);
-    tbb::parallel_for(tbb::blocked_range<size_t>(0, tiles.size(), 1), [&](const tbb::blocked_range<size_t>& range) {
-        for (size_t t = range.begin(); t < range.end(); ++t) {
-            if (stopRequested()) return;
-            const TileRect& tile = tiles[t];
-            TileImages images = shader.renderTile(tile, stop);
-            const int rows = images.interrupted ? images.rowsDone : tile.height();
-            tileRows[t] = rows;
-            for (size_t l = 0; l < layers.size(); ++l)
-                for (int y = 0; y < rows; ++y)
-                    std::copy_n(&images.layers[l].at(0, y), tile.width(), &layers[l].at(tile.x0, tile.y0 + y));
-            if (images.interrupted) return;
-            ++tilesDone;
-            boundExceeded += images.boundExceeded;
-            boundedEstimates += images.boundedEstimates;
-            const long long count = static_cast<long long>(tile.width()) * tile.height();
-            const long long done = pixelsDone.fetch_add(count) + count;
-            if (progress) progress("rendering", double(done) / totalPixels);
+    const int cap = settings.samplesPerPixel;
+    SampleSums sums;
+    std::vector<int> tileRows(tiles.size(), 0);
+    int tilesDone = 0, passes = 0, samples = cap;
+    if (settings.timeLimitSeconds <= 0.0) {
+        // A fixed render: every pass of a tile at once, tile after tile.
+        TilesShaded shaded = shadeTiles(shader, tiles, width, height, 0, passesFor(cap), stop, progress, "rendering");
+        sums = std::move(shaded.sums);
+        tileRows = std::move(shaded.tileRows);
+        tilesDone = shaded.tilesDone;
+        passes = passesFor(cap);
+    } else {
+        // Progressive: pass after pass over the whole image until the time limit.
+        const auto deadline =
+            start + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+                        std::chrono::duration<double>(settings.timeLimitSeconds));
+        const RenderStop passStop{[&] { return stop() || std::chrono::steady_clock::now() >= deadline; }};
+        sums = SampleSums::zeros(width, height, shader.layerPerPixel());
+        while (samplesAfter(passes, cap) < cap && !passStop()) {
+            const SamplePass pass = samplePass(passes, cap);
+            const std::string phase = "rendering pass " + std::to_string(passes + 1) + " (" +
+                                      std::to_string(pass.count) + " spp, " +
+                                      std::to_string(pass.first + pass.count) + " in all)";
+            TilesShaded shaded = shadeTiles(shader, tiles, width, height, passes, 1, passStop, progress, phase);
+            const bool complete = shaded.tilesDone == int(tiles.size());
+            if (passes == 0) {  // a first pass cut short is kept, as an interrupt keeps its rows
+                sums = std::move(shaded.sums);
+                tileRows = std::move(shaded.tileRows);
+                tilesDone = shaded.tilesDone;
+            } else if (complete) {
+                addPass(sums, shaded.sums);
+            }
+            if (!complete) break;
+            ++passes;
         }
-    });
-    if (coverage) {
-        coverage->tilesTotal = int(tiles.size());
-        coverage->tilesDone = tilesDone.load();
-        coverage->rowsDone = 0;
-        coverage->covered.assign(size_t(width) * height, 0);
-        for (size_t t = 0; t < tiles.size(); ++t) {
-            coverage->rowsDone += tileRows[t];
-            for (int y = tiles[t].y0; y < tiles[t].y0 + tileRows[t]; ++y)
-                std::fill_n(&coverage->covered[size_t(y) * width + tiles[t].x0], tiles[t].width(), uint8_t(1));
+        if (passes > 0) {
+            tilesDone = int(tiles.size());
+            for (size_t t = 0; t < tiles.size(); ++t) tileRows[t] = tiles[t].height();
         }
+        samples = std::max(1, samplesAfter(passes, cap));
     }
-    ImageSet result = assembleImageSet(std::move(layers), shader.layerNames(), &stats);
-    stats.boundExceeded = boundExceeded.load();
-    stats.boundedEstimates = boundedEstimates.load();
+    if (coverage) fillCoverage(*coverage, tiles, tileRows, tilesDone, width, height);
+    ImageSet result = assembleImageSet(resolveSamples(sums, shader.layerNames(), samples), shader.layerNames(), &stats);
+    stats.boundExceeded = sums.boundExceeded;
+    stats.boundedEstimates = sums.boundedEstimates;
     stats.seconds = secondsSince(start);
-    stats.cameraSamples = uint64_t(width) * height * settings.samplesPerPixel;
+    stats.cameraSamples = uint64_t(width) * height * uint64_t(samples);
+    stats.samplesPerPixel = samples;
+    stats.passes = passes;
     if (statistics) *statistics = stats;
     return result;
 }

@@ -1,15 +1,21 @@
 // Renderer: turns a Scene into an image with a chosen method, in parallel tiles
-// (TBB). Every pixel's random stream is seeded from (seed, film pixel index)
-// and its camera samples draw from it in order, so the image is bit-identical
-// whatever the thread count, tile size or order, or process that shades a tile,
-// and a crop window (camera.h) equals that window of the full film. The phases are public so that the service can split them: the
-// coordinator runs prepareLights once, workers run TileShader on leased tiles.
+// (TBB). Camera sample s of pixel (x, y) draws from its own random stream,
+// keyed by (seed, film pixel index, s), and the virtual-light parts evaluated
+// once per pixel from (seed, film pixel index, ~0); the samples are taken and
+// summed in passes (sample_passes.h). So the image is bit-identical whatever
+// the thread count, tile size or order, or process that shades a tile, a crop
+// window (camera.h) equals that window of the full film, and a progressive
+// render (RenderSettings::timeLimitSeconds) that completed P passes equals the
+// fixed render of 2^P - 1 samples. The phases are public so that the service can split them: the
+// coordinator runs prepareLights once, workers run TileShader on leased tiles (and passes).
 #pragma once
 
 #include "render/image/image.h"
 #include "render/integrators/transport_parts.h"
 #include "render/lightcuts/light_tree.h"
 #include "render/lightcuts/vrl_cut.h"
+#include "render/sample_passes.h"
+#include "render/sample_sums.h"
 #include "render/scene/scene.h"
 
 #include <array>
@@ -70,9 +76,16 @@ constexpr bool virtualLightsPerSample(RenderMethod m) { return m == RenderMethod
 // The method renders the four transport parts with virtual lights (every method but path).
 constexpr bool usesVirtualLights(RenderMethod m) { return m != RenderMethod::Path; }
 
+// The longest time limit a render takes (about 116 days): a guard against typos such as 1e30.
+inline constexpr double kMaxTimeLimitSeconds = 1e7;
+
 struct RenderSettings {
     RenderMethod method = RenderMethod::Path;
-    int samplesPerPixel = 1;  // path: per pixel; vrl: for parts (a)-(c)
+    int samplesPerPixel = 1;  // path: per pixel; vrl: for parts (a)-(c); with a time limit: the cap
+    // > 0: a progressive render: passes of 1, 2, 4, ... samples per pixel over the
+    // whole image until this many seconds of shading (after light preparation)
+    // have passed or samplesPerPixel is reached; the image holds the completed passes.
+    double timeLimitSeconds = 0.0;
     uint64_t seed = 0;
     bool jitter = false;  // false: rays through pixel centres (the paper's setting)
     int maxDepth = -1;    // Mitsuba meaning (see path_tracer.h)
@@ -91,6 +104,8 @@ struct RenderSettings {
 struct RenderStatistics {
     double seconds = 0.0;  // shading (after light tracing)
     uint64_t cameraSamples = 0;
+    int samplesPerPixel = 0;  // of the image (a progressive render: of its completed passes)
+    int passes = 0;           // sample passes in the image (sample_passes.h)
     // vrl method
     uint64_t vrlCount = 0;
     uint64_t lightPaths = 0;
@@ -110,7 +125,7 @@ struct RenderStatistics {
 using ProgressCallback = std::function<void(const char* phase, double fraction)>;
 
 // Checks the settings; throws std::invalid_argument for a non-positive sample
-// count or a negative error threshold.
+// count, a negative error threshold or a negative or non-finite time limit.
 void validateRenderSettings(const RenderSettings& settings);
 
 // The per-image light work of a render (the coordinator's part in the service):
@@ -142,7 +157,9 @@ std::vector<TileRect> imageTiles(int width, int height, int tileSize);
 // Stopping a render early (an interrupt): `requested` is polled from the
 // light-tracing progress, before each tile and before each row of a tile. A
 // tile stopped midway keeps its finished rows (the rest stay zero); when it
-// fires during light preparation, render throws RenderInterrupted.
+// fires during light preparation, render throws RenderInterrupted. A
+// progressive render keeps its completed passes and drops the one stopped,
+// unless it is the first (then its finished rows are kept, as above).
 struct RenderStop {
     std::function<bool()> requested;
     bool operator()() const { return requested && requested(); }
@@ -160,22 +177,43 @@ struct TileImages {
 // "eval", "inter", "cut"); throws like validateRenderSettings.
 std::vector<std::string> renderLayerNames(const RenderSettings& settings);
 
+// Sample s of pixel (x, y) of a tile draws from the stream
+// (seed, Rng::combine(camera.filmPixelIndex(x, y), s)) only.
+inline constexpr uint64_t kPixelLightsSample = ~uint64_t(0);  // the sample index of the once-per-pixel stream
+
+// A tile's sample sums (sample_sums.h) and how far it got.
+struct TileSums {
+    SampleSums sums;
+    bool interrupted = false;  // `stop` fired before the last row: only the first `rowsDone` rows are shaded
+    int rowsDone = 0;
+};
+
 // Shades tiles (the worker's part), in image pixels (the crop window's, if
-// any). Pixel (x, y) uses the stream (seed, camera.filmPixelIndex(x, y)) only,
-// so a tile's pixels equal those of a whole-image (and whole-film) render bit for bit.
-// renderTile is const and thread-safe; `lights` must outlive the TileShader.
+// any). Pixel (x, y) uses the streams of its film pixel only (above), so a
+// tile's pixels equal those of a whole-image (and whole-film) render bit for bit.
+// renderTile and shadeTile are const and thread-safe; `lights` must outlive the TileShader.
 class TileShader {
 public:
     TileShader(const Scene& scene, const RenderSettings& settings, const RenderLights& lights);
     ~TileShader();
     // Names of the layers after the image ("surface", ..., "eval", "inter", "cut").
     const std::vector<std::string>& layerNames() const { return layerNames_; }
+    // Per layer (image first): 1 where it holds one value per pixel rather than a sum over samples.
+    const std::vector<uint8_t>& layerPerPixel() const { return layerPerPixel_; }
+    // The fixed render's tile: passes [0, passesFor(samplesPerPixel)) resolved.
     TileImages renderTile(const TileRect& tile, const RenderStop& stop = {}) const;
+    // The sums of passes [firstPass, firstPass + passCount) folded in pass order
+    // (sample_passes.h), the samples capped at samplesPerPixel; a range must
+    // start at pass 0 or hold one pass (throws std::invalid_argument otherwise),
+    // so that addPass of its result onto passes [0, firstPass) is the canonical fold.
+    TileSums shadeTile(const TileRect& tile, int firstPass, int passCount, const RenderStop& stop = {}) const;
 
 private:
     const Scene& scene_;
     RenderSettings settings_;
     std::vector<std::string> layerNames_;
+    std::vector<uint8_t> layerPerPixel_;
+    bool lightsPerSample_ = false;
     std::unique_ptr<class TransportIntegrator> integrator_;
     std::unique_ptr<class VolumetricPathTracer> tracer_;
 };
@@ -202,7 +240,11 @@ struct RenderCoverage {
 // prepareLights, then every tile in parallel (TBB), then assembleImageSet.
 // The vrl method returns the sum in .image and each selected part as a layer.
 // With `stop`, tiles not started when it fires are skipped (zero) and
-// `coverage`, if given, says which were finished.
+// `coverage`, if given, says which were finished. With a time limit, the
+// passes run one after the other over the whole image (each in parallel
+// tiles) until the limit, `stop` or the sample cap; statistics->passes and
+// ->samplesPerPixel say what the image holds (a first pass cut short leaves a
+// partial image of 1 sample per pixel and passes 0, as an interrupt does).
 ImageSet render(const Scene& scene, const RenderSettings& settings, const ProgressCallback& progress = {},
                 RenderStatistics* statistics = nullptr, const RenderStop& stop = {},
                 RenderCoverage* coverage = nullptr);

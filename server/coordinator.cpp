@@ -185,8 +185,7 @@ void Coordinator::endJob(Job& job, v1::JobState state, const std::string& messag
     job.finishedUnixMs = unixMillisecondsNow();
     job.message = util::abbreviate(message, kMaxMessageBytes);  // shown in every listing: bounded
     leases_.dropJob(job);
-    job.layers.clear();
-    job.layers.shrink_to_fit();
+    job.passes.clear();
     store_.closeCheckpoint(job);
     store_.writeRecord(job);
     store_.pruneAssets();
@@ -235,12 +234,15 @@ void Coordinator::prepare(Job& job) {
         job.doneAtStart = job.doneCount;
         leases_.queueMissing(job);
         store_.openCheckpoint(job);
-        job.renderStart = Clock::now();
+        job.renderStart = Clock::now();  // a restarted coordinator gives a time-limited job its whole limit again
+        if (job.settings.timeLimitSeconds > 0.0)
+            job.deadline = job.renderStart + std::chrono::duration_cast<Clock::duration>(
+                                                 std::chrono::duration<double>(job.settings.timeLimitSeconds));
         spdlog::info("{}: prepared in {:.3f} s: {}x{}, {} tiles ({} restored), {} VRLs, lights blob {} bytes", job.id,
                      secondsSince(prepared.start), prepared.width, prepared.height, prepared.tiles.size(),
                      job.doneCount, prepared.statistics.vrlCount, prepared.lights ? prepared.lights->size() : 0);
         touch(job);
-        if (job.doneCount == job.tiles.size()) finishJob(job);
+        if (job.passes.passesDone() == job.passes.passesTotal()) finishJob(job);
     } catch (const std::exception& e) {
         std::lock_guard lock(mutex_);
         if (job.state == v1::JOB_STATE_PREPARING) endJob(job, v1::JOB_STATE_FAILED, e.what());
@@ -307,8 +309,9 @@ v1::SubmitTileReply Coordinator::submitTile(const v1::TileResult& result, bool* 
     if (!lease)  // no live lease: a late result still counts, one for a lease never issued not
         refused = leases_.refuseUnissued(result, job);
     bool duplicate = false;
+    TileMerge merge;
     if (refused.empty()) {
-        const TileMerge merge = mergeTile(job, result);
+        merge = mergeTile(job, result);
         refused = merge.refusal;
         duplicate = merge.duplicate;
         if (duplicate) ++statistics_.duplicatesDropped;
@@ -321,8 +324,9 @@ v1::SubmitTileReply Coordinator::submitTile(const v1::TileResult& result, bool* 
         reply.set_accepted(true);
         ++statistics_.tilesAccepted;
         if (lease) leases_.erase(result.lease_id());  // other leases on the tile expire harmlessly
+        leases_.queueNextPass(job, merge.tile, merge.passCompleted);
         touch(job);
-        if (job.doneCount == job.tiles.size()) finishJob(job);
+        if (job.passes.passesDone() == job.passes.passesTotal()) finishJob(job);
     } else {
         reply.set_reason(refused);
         if (!duplicate) {
@@ -375,6 +379,11 @@ void Coordinator::reaperLoop() {
         const auto now = Clock::now();
         workers_.forgetSilent(now);
         statistics_.leasesExpired += leases_.requeueExpired(now, workers_);
+        // Time-limited jobs past their limit end with the passes complete by then.
+        std::vector<Job*> expired;
+        for (const auto& [id, job] : store_.jobs())
+            if (job->state == v1::JOB_STATE_RENDERING && job->deadline && now >= *job->deadline) expired.push_back(job.get());
+        for (Job* job : expired) finishJob(*job);
         if (options_.retention.count() > 0 && now >= nextPurge_) {
             purgeLocked(options_.retention);
             nextPurge_ = now + purgePeriod(options_.retention);
@@ -385,6 +394,12 @@ void Coordinator::reaperLoop() {
 // ------------------------------------------------------------------ the end of a job
 
 void Coordinator::finishJob(Job& job) {
+    if (job.passes.passesDone() == 0 && job.passes.tilesInCurrentPass() == 0) {
+        endJob(job, v1::JOB_STATE_FAILED,
+               "the time limit of " + std::to_string(job.settings.timeLimitSeconds) +
+                   " s ran out before any tile was rendered; give a longer --time-limit");
+        return;
+    }
     if (const auto error = writeJobImage(job)) {
         endJob(job, v1::JOB_STATE_FAILED, "cannot write the image: " + *error);
         return;

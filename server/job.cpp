@@ -2,6 +2,8 @@
 
 #include "render/core/timing.h"
 
+#include <algorithm>
+
 namespace vrl::server {
 
 bool isTerminal(v1::JobState state) {
@@ -21,13 +23,20 @@ v1::JobProgress progressOf(const Job& job) {
     p.set_priority(job.spec.priority());
     p.set_message(job.message);
     p.set_tiles_total(uint32_t(job.tiles.size()));
-    p.set_tiles_done(job.doneCount);
+    // A time-limited job renders pass after pass: its tiles count the pass under way.
+    p.set_tiles_done(job.passes.progressive() ? job.passes.tilesInCurrentPass() : job.doneCount);
+    p.set_passes_done(uint32_t(job.passes.passesDone()));
+    p.set_passes_total(uint32_t(job.passes.passesTotal()));
+    p.set_samples_per_pixel(samplesAfter(job.passes.passesDone(), job.settings.samplesPerPixel));
+    p.set_time_limit_seconds(job.settings.timeLimitSeconds);
     p.set_preparing_fraction(job.preparingFraction);
     p.set_preparing_phase(job.preparingPhase);
     p.set_submitted_unix_ms(job.submittedUnixMs);
     p.set_finished_unix_ms(job.finishedUnixMs);
     double eta = -1.0;
-    if (job.state == v1::JOB_STATE_RENDERING && job.doneCount > job.doneAtStart) {
+    if (job.state == v1::JOB_STATE_RENDERING && job.deadline) {
+        eta = std::max(0.0, std::chrono::duration<double>(*job.deadline - std::chrono::steady_clock::now()).count());
+    } else if (job.state == v1::JOB_STATE_RENDERING && job.doneCount > job.doneAtStart) {
         const double elapsed = secondsSince(job.renderStart);
         eta = elapsed / double(job.doneCount - job.doneAtStart) * double(job.tiles.size() - job.doneCount);
     } else if (job.state == v1::JOB_STATE_DONE) {

@@ -12,6 +12,7 @@
 #include "render/image/image.h"
 #include "render/renderer.h"
 #include "render/scene/camera.h"
+#include "server/tile_passes.h"
 #include "vrl/v1/vrl.pb.h"
 
 #include <chrono>
@@ -55,13 +56,15 @@ struct Job {
     v1::JobAssets assets;
     std::deque<uint32_t> pending;  // may hold tiles done since they were queued: skipped when popped
     std::vector<uint8_t> queued;   // tile is in `pending`
-    std::vector<uint8_t> done;
+    std::vector<uint8_t> waiting;  // progressive: tile is ahead of the others; queued again when a pass completes
+    std::vector<uint8_t> done;     // every pass of the tile accepted
     std::vector<int> rejections;
     uint32_t doneCount = 0;
-    std::vector<Image> layers;
-    uint64_t boundExceeded = 0, boundedEstimates = 0;
+    TilePasses passes;             // the tiles' sample sums, pass by pass
     RenderStatistics renderStatistics;
     std::chrono::steady_clock::time_point renderStart;
+    // A time-limited job: no lease after this; then it ends with the passes complete by then.
+    std::optional<std::chrono::steady_clock::time_point> deadline;
     uint32_t doneAtStart = 0;  // tiles restored from the checkpoint
     struct WorkerShare {
         uint64_t tiles = 0, pixels = 0;

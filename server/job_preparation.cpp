@@ -92,9 +92,11 @@ void JobPreparation::install(Job& job, const PreparedJob& prepared) const {
     job.camera = prepared.camera;
     job.done.assign(tiles.size(), 0);
     job.queued.assign(tiles.size(), 0);
+    job.waiting.assign(tiles.size(), 0);
     job.rejections.assign(tiles.size(), 0);
     job.doneCount = 0;
-    job.layers.assign(1 + prepared.layerNames.size(), Image(prepared.width, prepared.height));
+    const bool progressive = prepared.settings.timeLimitSeconds > 0.0;
+    job.passes = TilePasses(tiles.size(), passesFor(prepared.settings.samplesPerPixel), progressive);
     job.renderStatistics = prepared.statistics;
     job.assets.set_job_id(job.id);
     *job.assets.mutable_spec() = job.spec;

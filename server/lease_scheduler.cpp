@@ -32,11 +32,30 @@ void LeaseScheduler::queueMissing(Job& job) {
         }
 }
 
+void LeaseScheduler::queueNextPass(Job& job, uint32_t tile, bool passCompleted) {
+    const auto queue = [&](uint32_t t) {
+        if (job.done[t] || job.queued[t]) return;
+        if (job.passes.nextLease(t).count == 0) {
+            job.waiting[t] = 1;
+            return;
+        }
+        job.waiting[t] = 0;
+        job.queued[t] = 1;
+        job.pending.push_back(t);
+    };
+    if (passCompleted)
+        for (uint32_t t = 0; t < job.tiles.size(); ++t)
+            if (job.waiting[t]) queue(t);
+    queue(tile);
+}
+
 v1::LeaseReply LeaseScheduler::lease(const std::string& workerId, uint32_t maxTiles) {
     v1::LeaseReply reply;
     std::vector<Job*> ready;
+    const auto now = Clock::now();
     for (const auto& [id, job] : store_.jobs())
-        if (job->state == v1::JOB_STATE_RENDERING && !job->pending.empty()) ready.push_back(job.get());
+        if (job->state == v1::JOB_STATE_RENDERING && !job->pending.empty() && !(job->deadline && now >= *job->deadline))
+            ready.push_back(job.get());
     std::sort(ready.begin(), ready.end(), [](const Job* a, const Job* b) {
         return a->spec.priority() != b->spec.priority() ? a->spec.priority() > b->spec.priority()
                                                         : a->sequence < b->sequence;
@@ -49,8 +68,13 @@ v1::LeaseReply LeaseScheduler::lease(const std::string& workerId, uint32_t maxTi
             job->pending.pop_front();
             job->queued[tile] = 0;
             if (job->done[tile]) continue;  // accepted since it was queued
+            const TilePasses::Range passes = job->passes.nextLease(tile);
+            if (passes.count == 0) {  // ahead of the other tiles: queued again when a pass completes
+                job->waiting[tile] = 1;
+                continue;
+            }
             const std::string leaseId = job->id + ":" + std::to_string(tile) + ":" + std::to_string(++nextLease_);
-            leases_[leaseId] = Lease{job->id, tile, workerId, Clock::now() + leaseTimeout_};
+            leases_[leaseId] = Lease{job->id, tile, passes, workerId, Clock::now() + leaseTimeout_};
             auto* lease = reply.add_leases();
             lease->set_lease_id(leaseId);
             lease->set_job_id(job->id);
@@ -60,6 +84,8 @@ v1::LeaseReply LeaseScheduler::lease(const std::string& workerId, uint32_t maxTi
             lease->mutable_tile()->set_x1(r.x1);
             lease->mutable_tile()->set_y1(r.y1);
             lease->set_deadline_ms(uint32_t(leaseTimeout_.count()));
+            lease->set_first_pass(uint32_t(passes.first));
+            lease->set_pass_count(uint32_t(passes.count));
             if (described.insert(job->id).second) *reply.add_jobs() = job->assets;
         }
         if (uint32_t(reply.leases_size()) >= wanted) break;
@@ -78,7 +104,8 @@ const LeaseScheduler::Lease* LeaseScheduler::leaseOf(const v1::TileResult& resul
     if (!lease) return nullptr;
     const auto at = job.tileAt.find({int(result.tile().x0()), int(result.tile().y0())});
     if (lease->jobId != job.id || lease->workerId != result.worker_id() || at == job.tileAt.end() ||
-        at->second != lease->tile)
+        at->second != lease->tile || result.first_pass() != uint32_t(lease->passes.first) ||
+        result.pass_count() != uint32_t(lease->passes.count))
         return nullptr;
     return lease;
 }

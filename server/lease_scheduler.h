@@ -13,7 +13,11 @@
 //   is skipped when popped; a job that ends loses its queue and its leases;
 // - a result whose lease expired still counts if the lease was issued for that
 //   tile (wasIssued): the pixels are the same. tile_assembly.h takes each
-//   tile's first valid result only.
+//   tile's first valid result for each pass only;
+// - a lease covers the passes TilePasses::nextLease gives (tile_passes.h): all
+//   of them, or for a time-limited job the tile's next pass; a tile too far
+//   ahead of the others waits (Job::waiting) and is queued again when a pass
+//   completes over the image; a time-limited job past its deadline is leased nothing.
 //
 // Not thread-safe by itself: the Coordinator calls it with its mutex held.
 #pragma once
@@ -36,6 +40,7 @@ public:
     struct Lease {
         std::string jobId;
         uint32_t tile = 0;
+        TilePasses::Range passes;
         std::string workerId;
         Clock::time_point deadline;
     };
@@ -45,6 +50,9 @@ public:
 
     // Queues every tile of the job not yet done, in tile order.
     void queueMissing(Job& job);
+    // After a result of `tile` was merged: queues its next pass, or marks it
+    // waiting; when the result completed a pass, queues every waiting tile too.
+    void queueNextPass(Job& job, uint32_t tile, bool passCompleted);
     // Up to clamp(maxTiles, 1, 64) leases for the worker, with the assets of each job
     // among them; none: retry_after_ms is set.
     v1::LeaseReply lease(const std::string& workerId, uint32_t maxTiles);

@@ -74,16 +74,34 @@ TileMerge mergeTile(Job& job, const v1::TileResult& result) {
                         std::to_string(t.y0()) + ", " + std::to_string(t.y1()) + ") differ from the job's tiling";
         return merge;
     }
-    if (job.done[tile]) {
-        merge.duplicate = true;
-        merge.refusal = "duplicate: this tile was already accepted";
-        return merge;
+    const TilePasses::Range passes{int(std::min<uint32_t>(result.first_pass(), kMaxPasses)),
+                                   int(std::min<uint32_t>(result.pass_count(), kMaxPasses))};
+    switch (job.passes.fit(tile, passes)) {
+        case TilePasses::Fit::Expected: break;
+        case TilePasses::Fit::Duplicate:
+            merge.duplicate = true;
+            merge.refusal = "duplicate: these passes of the tile were already accepted";
+            return merge;
+        case TilePasses::Fit::Unexpected:
+            merge.refusal = "passes [" + std::to_string(result.first_pass()) + ", +" +
+                            std::to_string(result.pass_count()) + ") are not what tile " + std::to_string(tile) +
+                            " needs next (" + std::to_string(job.passes.nextLease(tile).first) + ", +" +
+                            std::to_string(job.passes.nextLease(tile).count) + ")";
+            return merge;
     }
-    if (size_t(result.layers_size()) != job.layers.size()) {
+    const size_t layerCount = 1 + job.layerNames.size();
+    if (size_t(result.layers_size()) != layerCount) {
         merge.refusal = "wrong number of layers: " + std::to_string(result.layers_size()) + ", expected " +
-                        std::to_string(job.layers.size());
+                        std::to_string(layerCount);
         return merge;
     }
+    const std::vector<uint8_t>& perPixel = job.passes.perPixel();
+    for (int l = 0; l < result.layers_size(); ++l)
+        if (!perPixel.empty() && result.layers(l).per_pixel() != (perPixel[size_t(l)] != 0)) {
+            merge.refusal = "layer " + std::to_string(l) + " is " + (result.layers(l).per_pixel() ? "" : "not ") +
+                            "per pixel, unlike the job's earlier tiles";
+            return merge;
+        }
     const size_t floats = size_t(rect.width()) * rect.height() * 3;
     for (int l = 0; l < result.layers_size(); ++l) {
         const auto& layer = result.layers(l);
@@ -108,16 +126,19 @@ TileMerge mergeTile(Job& job, const v1::TileResult& result) {
             }
         }
     }
-    for (int l = 0; l < result.layers_size(); ++l) {
-        const char* data = result.layers(l).rgb().data();
-        for (int y = 0; y < rect.height(); ++y)
-            std::memcpy(static_cast<void*>(&job.layers[size_t(l)].at(rect.x0, rect.y0 + y)),
-                        data + size_t(y) * rect.width() * 3 * sizeof(float), size_t(rect.width()) * 3 * sizeof(float));
+    std::vector<uint8_t> flags;
+    for (int l = 0; l < result.layers_size(); ++l) flags.push_back(result.layers(l).per_pixel() ? 1 : 0);
+    SampleSums sums = SampleSums::zeros(rect.width(), rect.height(), flags);
+    for (int l = 0; l < result.layers_size(); ++l)
+        std::memcpy(static_cast<void*>(&sums.layers[size_t(l)].at(0, 0)), result.layers(l).rgb().data(),
+                    floats * sizeof(float));
+    sums.boundExceeded = result.bound_exceeded();
+    sums.boundedEstimates = result.bounded_estimates();
+    merge.passCompleted = job.passes.accept(tile, passes, std::move(sums));
+    if (job.passes.tileDone(tile) && !job.done[tile]) {
+        job.done[tile] = 1;
+        ++job.doneCount;
     }
-    job.done[tile] = 1;
-    ++job.doneCount;
-    job.boundExceeded += result.bound_exceeded();
-    job.boundedEstimates += result.bounded_estimates();
     return merge;
 }
 
@@ -130,15 +151,9 @@ void creditWorker(Job& job, const std::string& workerName, const v1::TileResult&
 }
 
 std::optional<std::string> writeJobImage(Job& job) {
-    RenderStatistics stats = job.renderStatistics;
-    ImageSet images = assembleImageSet(std::move(job.layers), job.layerNames, &stats);
-    job.layers.clear();
-    stats.boundExceeded = job.boundExceeded;
-    stats.boundedEstimates = job.boundedEstimates;
-    stats.seconds = secondsSince(job.renderStart);
-    const RenderRecord record =
-        recordOf(job.id, job.spec, job.sceneNotes, job.settings, stats, job.phases, job.workers.size());
-    writeRenderMetadata(record, *job.camera, images.metadata);
+    PartialImageInput in = partialImageInput(job);
+    job.passes.clear();
+    ImageSet images = assembleJobImage(in);
     try {
         writeExr(job.dir / "image.exr", images);  // atomic: a temporary sibling, then a rename
     } catch (const std::exception& e) {
@@ -154,40 +169,57 @@ namespace vrl::server {
 
 PartialImageInput partialImageInput(const Job& job) {
     PartialImageInput in;
+    in.sums = job.passes.imageSums(job.tiles, job.width, job.height, std::vector<uint8_t>(1 + job.layerNames.size(), 0),
+                                   &in.tilesCovered);
+    in.passes = job.passes.passesDone();
     in.id = job.id;
     in.spec = job.spec;
     in.width = job.width;
     in.height = job.height;
     in.tiles = job.tiles;
-    in.done = job.done;
-    in.doneCount = job.doneCount;
-    in.layers = job.layers;
     in.layerNames = job.layerNames;
     in.sceneNotes = job.sceneNotes;
     in.settings = job.settings;
     in.camera = job.camera;
     in.statistics = job.renderStatistics;
-    in.statistics.boundExceeded = job.boundExceeded;
-    in.statistics.boundedEstimates = job.boundedEstimates;
+    in.statistics.boundExceeded = in.sums.boundExceeded;
+    in.statistics.boundedEstimates = in.sums.boundedEstimates;
     in.statistics.seconds = secondsSince(job.renderStart);
     in.phases = job.phases;
     in.workers = job.workers.size();
     return in;
 }
 
-std::string assemblePartialImage(PartialImageInput in, const std::filesystem::path& scratchDir) {
+ImageSet assembleJobImage(PartialImageInput& in) {
+    // Whole passes: a complete image of their samples; none (a time-limited job's first pass cut
+    // short, or an unfinished fixed job): the tiles done so far, marked partial.
+    const bool whole = in.passes > 0;
+    const int samples = whole ? samplesAfter(in.passes, in.settings.samplesPerPixel)
+                        : in.settings.timeLimitSeconds > 0.0 ? 1 : in.settings.samplesPerPixel;
+    in.statistics.samplesPerPixel = samples;
+    in.statistics.passes = in.passes;
+    in.statistics.cameraSamples = uint64_t(in.width) * uint64_t(in.height) * uint64_t(samples);
+    ImageSet images = assembleImageSet(resolveSamples(in.sums, in.layerNames, samples), in.layerNames, &in.statistics);
+    in.sums = {};
+    const RenderRecord record =
+        recordOf(in.id, in.spec, in.sceneNotes, in.settings, in.statistics, in.phases, in.workers);
+    writeRenderMetadata(record, *in.camera, images.metadata);
+    if (whole) return images;
     std::vector<uint8_t> covered(size_t(in.width) * size_t(in.height), 0);
+    int tilesDone = 0;
     for (size_t t = 0; t < in.tiles.size(); ++t) {
-        if (!in.done[t]) continue;
+        if (!in.tilesCovered[t]) continue;
+        ++tilesDone;
         const TileRect& r = in.tiles[t];
         for (int y = r.y0; y < r.y1; ++y)
             std::fill_n(covered.begin() + ptrdiff_t(size_t(y) * size_t(in.width) + size_t(r.x0)), r.width(), uint8_t(1));
     }
-    ImageSet images = assembleImageSet(std::move(in.layers), in.layerNames, &in.statistics);
-    const RenderRecord record =
-        recordOf(in.id, in.spec, in.sceneNotes, in.settings, in.statistics, in.phases, in.workers);
-    writeRenderMetadata(record, *in.camera, images.metadata);
-    markPartial(images, covered, int(in.doneCount), int(in.tiles.size()));
+    markPartial(images, covered, tilesDone, int(in.tiles.size()));
+    return images;
+}
+
+std::string assemblePartialImage(PartialImageInput in, const std::filesystem::path& scratchDir) {
+    ImageSet images = assembleJobImage(in);
     const std::filesystem::path file = scratchDir / ("partial-" + util::randomHex(8) + ".exr");
     writeExr(file, images);
     std::string bytes;

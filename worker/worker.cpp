@@ -321,9 +321,11 @@ void Worker::leaseLoop() {
             const TileRect tile{int(lease.tile().x0()), int(lease.tile().y0()), int(lease.tile().x1()),
                                 int(lease.tile().y1())};
             const auto start = std::chrono::steady_clock::now();
-            TileImages images;
+            TileSums shaded;
             try {
-                images = job->shader->renderTile(tile);
+                // The lease's sample passes: all of them at once, or one pass of a time-limited job.
+                shaded = job->shader->shadeTile(tile, int(std::min<uint32_t>(lease.first_pass(), kMaxPasses)),
+                                                int(std::min<uint32_t>(lease.pass_count(), kMaxPasses)));
             } catch (const std::exception& e) {
                 spdlog::error("job {}: shading a tile failed: {}", lease.job_id(), e.what());
                 failure = e.what();
@@ -335,14 +337,17 @@ void Worker::leaseLoop() {
             result.set_lease_id(lease.lease_id());
             result.set_job_id(lease.job_id());
             *result.mutable_tile() = lease.tile();
-            for (size_t l = 0; l < images.layers.size(); ++l) {
+            result.set_first_pass(lease.first_pass());
+            result.set_pass_count(lease.pass_count());
+            for (size_t l = 0; l < shaded.sums.layers.size(); ++l) {  // sample sums, resolved by the coordinator
                 auto* layer = result.add_layers();
                 layer->set_name(l == 0 ? "" : job->shader->layerNames()[l - 1]);
-                const auto& pixels = images.layers[l].pixels();
+                layer->set_per_pixel(shaded.sums.perPixel[l] != 0);
+                const auto& pixels = shaded.sums.layers[l].pixels();
                 layer->set_rgb(reinterpret_cast<const char*>(pixels.data()), pixels.size() * sizeof(Rgb));
             }
-            result.set_bound_exceeded(images.boundExceeded);
-            result.set_bounded_estimates(images.boundedEstimates);
+            result.set_bound_exceeded(shaded.sums.boundExceeded);
+            result.set_bounded_estimates(shaded.sums.boundedEstimates);
             result.set_seconds(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
             for (int attempt = 0; attempt < 5 && !killed_; ++attempt) {
                 grpc::ClientContext submitContext;

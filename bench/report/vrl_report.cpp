@@ -281,6 +281,7 @@ const char* methodTitle(RenderMethod m) {
         case RenderMethod::Path: return "path tracing";
         case RenderMethod::Vrl: return "plain VRLs";
         case RenderMethod::VrlLightcuts: return "VRL Lightcuts";
+        case RenderMethod::VrlStochastic: return "stochastic VRL Lightcuts";
         case RenderMethod::VplLightcuts: return "VPL Lightcuts";
         case RenderMethod::Vpl: return "plain VPLs";
     }

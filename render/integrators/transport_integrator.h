@@ -79,8 +79,11 @@ public:
 
     // Part (c) is estimated from VRLs (not path-sampled).
     bool vrlLitSurfaces() const { return !settings_.vpls; }
-    // The virtual-light parts are themselves Monte Carlo estimates to average over
-    // the camera samples (stochastic cuts), not computed once per pixel.
+    // Whether the renderer evaluates virtualLightParts once per camera sample
+    // (with that sample's random stream and ray, averaged like (a), (b)) rather
+    // than once per pixel (with the pixel's own stream (seed, pixel, ~0), in the
+    // first sample pass only, so (c), (d) do not depend on the sample count):
+    // true for stochastic cuts, whose (c), (d) are Monte Carlo estimates.
     bool virtualLightsPerSample() const { return stochastic_ != nullptr; }
 
 private:

@@ -100,6 +100,10 @@ void validateJobSpec(const v1::JobSpec& spec, const ServiceLimits& limits) {
     if (p.samples_per_pixel() < 0 || p.samples_per_pixel() > limits.maxSamplesPerPixel)
         throw JobSpecError("samples per pixel must be in 0..." + std::to_string(limits.maxSamplesPerPixel) +
                            " (0: the scene's), got " + std::to_string(p.samples_per_pixel()));
+    if (!(p.time_limit_seconds() >= 0.0 && p.time_limit_seconds() <= kMaxTimeLimitSeconds))
+        throw JobSpecError("the time limit must be 0 (none) or a number of seconds up to " +
+                           std::to_string(int64_t(kMaxTimeLimitSeconds)) + ", got " +
+                           std::to_string(p.time_limit_seconds()));
     if (p.vrl_count() > limits.maxVrls || p.light_paths() > limits.maxVrls)
         throw JobSpecError("the job asks for more than " + std::to_string(limits.maxVrls) +
                            " VRLs or light paths, this coordinator's limit");
@@ -188,7 +192,11 @@ ResolvedJob resolveJob(const std::filesystem::path& sceneFile, const v1::JobSpec
     RenderSettings& s = job.settings;
     s.method = jobMethod(p, description.integrator);
     checkLightCount(s.method, p);
-    s.samplesPerPixel = p.samples_per_pixel() > 0 ? p.samples_per_pixel() : sensor.sampleCount;
+    // With a time limit the sample count is a cap: the spec's, or none (the most a job may have).
+    s.timeLimitSeconds = p.time_limit_seconds();
+    s.samplesPerPixel = p.samples_per_pixel() > 0 ? p.samples_per_pixel()
+                        : s.timeLimitSeconds > 0.0 ? std::min(limits.maxSamplesPerPixel, kMaxSampleCount)
+                                                   : sensor.sampleCount;
     s.seed = p.seed();
     s.jitter = p.jitter();
     s.maxDepth = p.max_depth() >= -1 ? p.max_depth() : description.integrator.maxDepth;

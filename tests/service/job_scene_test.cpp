@@ -9,7 +9,9 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <fstream>
+#include <limits>
 #include <string>
 
 namespace vrl {
@@ -75,6 +77,34 @@ TEST(ResolveJob, AMethodFromTheSceneStillNeedsLights) {
     }
     spec.mutable_parameters()->set_method("path");
     EXPECT_NO_THROW(rpc::resolveJob(writeScene(dir, "<integrator type=\"vrl\"/>"), spec, {}));
+}
+
+// A time limit makes the sample count a cap: the spec's, or no cap (the most a
+// job may have) where the spec leaves it to the scene; a negative, NaN or
+// absurd limit is refused before the scene is read.
+TEST(ResolveJob, ATimeLimitMakesTheSampleCountACap) {
+    const test::TempDir dir("vrl-job-scene");
+    const auto scene = writeScene(dir, "");  // sampleCount 2
+    v1::JobSpec spec = specWithMethod("path");
+    EXPECT_EQ(rpc::resolveJob(scene, spec, {}).settings.samplesPerPixel, 2);
+    EXPECT_EQ(rpc::resolveJob(scene, spec, {}).settings.timeLimitSeconds, 0.0);
+    spec.mutable_parameters()->set_time_limit_seconds(30.0);
+    rpc::ServiceLimits limits;
+    limits.maxSamplesPerPixel = 4096;
+    const RenderSettings capped = rpc::resolveJob(scene, spec, limits).settings;
+    EXPECT_EQ(capped.timeLimitSeconds, 30.0);
+    EXPECT_EQ(capped.samplesPerPixel, 4096);
+    spec.mutable_parameters()->set_samples_per_pixel(100);
+    EXPECT_EQ(rpc::resolveJob(scene, spec, limits).settings.samplesPerPixel, 100);
+    for (const double bad : {-1.0, std::nan(""), 1e30, -std::numeric_limits<double>::infinity()}) {
+        spec.mutable_parameters()->set_time_limit_seconds(bad);
+        try {
+            rpc::validateJobSpec(spec, {});
+            ADD_FAILURE() << "time limit " << bad << " accepted";
+        } catch (const rpc::JobSpecError& e) {
+            EXPECT_NE(std::string(e.what()).find("time limit"), std::string::npos) << e.what();
+        }
+    }
 }
 
 TEST(ResolveJob, CropAppliesAfterTheResolution) {

@@ -665,10 +665,10 @@ std::vector<v1::TileLease> leaseTiles(Harness& h, const std::string& workerId, c
 }
 
 // Every kind of malformed TileResult for a `path` job (one layer) whose tiles
-// `leases` hold (at least 16; each refused result sends its tile back to the
+// `leases` hold (at least 20; each refused result sends its tile back to the
 // queue once, far from the job's rejection limit). Unused leases are given back.
 void tileResultCases(Harness& h, const std::string& workerId, const std::vector<v1::TileLease>& leases) {
-    ASSERT_GE(leases.size(), 16u);
+    ASSERT_GE(leases.size(), 20u);
     size_t next = 0;
     auto resultFor = [&](const v1::TileLease& lease) {
         v1::TileResult result;
@@ -676,6 +676,8 @@ void tileResultCases(Harness& h, const std::string& workerId, const std::vector<
         result.set_lease_id(lease.lease_id());
         result.set_job_id(lease.job_id());
         *result.mutable_tile() = lease.tile();
+        result.set_first_pass(lease.first_pass());  // the lease's sample passes
+        result.set_pass_count(lease.pass_count());
         const auto& t = lease.tile();
         const std::vector<float> pixels(size_t(t.x1() - t.x0()) * (t.y1() - t.y0()) * 3, 0.25f);
         result.add_layers()->set_rgb(pixels.data(), pixels.size() * sizeof(float));
@@ -730,6 +732,10 @@ void tileResultCases(Harness& h, const std::string& workerId, const std::vector<
     };
     const std::vector<Case> content = {
         {"no layers", [](R& r) { r.clear_layers(); }, StatusCode::INVALID_ARGUMENT, "wrong number of layers: 0, expected 1"},
+        {"passes the tile does not need", [](R& r) { r.set_first_pass(r.first_pass() + 1); },
+         StatusCode::INVALID_ARGUMENT, "are not what tile"},
+        {"no passes", [](R& r) { r.set_pass_count(0); }, StatusCode::INVALID_ARGUMENT, "are not what tile"},
+        {"2^32-1 passes", [](R& r) { r.set_pass_count(~0u); }, StatusCode::INVALID_ARGUMENT, "are not what tile"},
         {"an extra layer", [](R& r) { *r.add_layers() = r.layers(0); }, StatusCode::INVALID_ARGUMENT,
          "wrong number of layers: 2, expected 1"},
         {"4 bytes short", [&](R& r) { r.mutable_layers(0)->mutable_rgb()->resize(floatBytes - 4); },
@@ -910,7 +916,7 @@ TEST(MalformedRequests, BadTileResultsAreRefusedAndTheJobStillFinishes) {
     const std::string id = h.submit(makeSpec("path", 2, 64, 64, 8));  // 64 tiles
     h.waitFor(id, [](v1::JobState s) { return s == v1::JOB_STATE_RENDERING; });
     const std::string workerId = h.registerWorker("forger");
-    tileResultCases(h, workerId, leaseTiles(h, workerId, id, 20));
+    tileResultCases(h, workerId, leaseTiles(h, workerId, id, 24));
     EXPECT_EQ(h.coordinator().jobProgress(id).state(), v1::JOB_STATE_RENDERING);
     EXPECT_EQ(h.coordinator().jobProgress(id).tiles_done(), 1u);  // the one good result
     h.expectServing();
@@ -946,7 +952,7 @@ TEST(MalformedRequests, ABarrageLeavesTheCoordinatorServingAndValidJobsComplete)
     const std::string vplLightcuts = h.submit(makeSpec("vpl-lightcuts", 1, 16, 12, 8));
     h.waitFor(victim, [](v1::JobState s) { return s == v1::JOB_STATE_RENDERING; });
     const std::string forger = h.registerWorker("forger");
-    const auto leases = leaseTiles(h, forger, victim, 20);
+    const auto leases = leaseTiles(h, forger, victim, 24);
     h.startWorker("good");
     const auto broken = submitBrokenScenes(h);
 

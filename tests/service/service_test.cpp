@@ -183,6 +183,59 @@ TEST(Service, PlainVrlImageIsBitIdenticalToTheEmbeddedRender) {
     expectBitIdentical(embeddedRender(spec), cluster.waitForImage(cluster.submit(spec)));
 }
 
+// A time-limited job leases (tile, pass): with --spp 6 as its cap it runs 3
+// passes whatever the clock, and its image equals the embedded fixed render of
+// 6 samples bit for bit, every (tile, pass) taken exactly once, even when a
+// worker dies midway (its lease expires and the pass is leased again).
+TEST(Service, ProgressiveJobEqualsTheFixedRenderOfItsPasses) {
+    Cluster cluster;
+    v1::JobSpec spec = makeSpec("vrl-lightcuts", 6, 13, 32, 24, 8);  // 12 tiles
+    spec.mutable_parameters()->set_time_limit_seconds(600.0);
+    const std::string id = cluster.submit(spec);
+    worker::Worker& doomed = cluster.startWorker("doomed");
+    waitUntil([&] { return cluster.coordinator().jobProgress(id).tiles_done() >= 2; });
+    doomed.kill();
+    cluster.startWorker("a");
+    cluster.startWorker("b");
+    const ImageSet image = cluster.waitForImage(id);
+    v1::JobSpec fixed = spec;
+    fixed.mutable_parameters()->set_time_limit_seconds(0.0);
+    expectBitIdentical(embeddedRender(fixed), image);
+    EXPECT_EQ(metadataNumber(image.metadata.at("vrl.progressive.passes")), 3.0);
+    EXPECT_EQ(metadataNumber(image.metadata.at("vrl.spp")), 6.0);
+    EXPECT_EQ(image.metadata.count("vrl.partial"), 0u);
+    const v1::JobProgress progress = cluster.coordinator().jobProgress(id);
+    EXPECT_EQ(progress.passes_done(), 3u);
+    EXPECT_EQ(progress.passes_total(), 3u);
+    EXPECT_EQ(progress.samples_per_pixel(), 6);
+    EXPECT_EQ(cluster.coordinator().statistics().tilesAccepted, 12u * 3u);
+}
+
+// The time limit ends the job with its completed passes: nothing here depends
+// on how many there are (the machine's speed), only that they are whole
+// passes equal to the fixed render of their samples, or, if the limit ran out
+// in the first pass, a partial image.
+TEST(Service, TimeLimitedJobEndsWithItsCompletedPasses) {
+    Cluster cluster;
+    cluster.startWorker("a");
+    cluster.startWorker("b");
+    v1::JobSpec spec = makeSpec("path", 0, 5, 16, 8, 8);
+    spec.mutable_parameters()->set_time_limit_seconds(1.0);
+    const ImageSet image = cluster.waitForImage(cluster.submit(spec));
+    const int passes = int(metadataNumber(image.metadata.at("vrl.progressive.passes")));
+    const int spp = int(metadataNumber(image.metadata.at("vrl.spp")));
+    if (passes == 0) {
+        EXPECT_EQ(image.metadata.count("vrl.partial"), 1u);
+        GTEST_SKIP() << "the time limit ran out in the first pass on this machine";
+    }
+    EXPECT_EQ(spp, (1 << passes) - 1);
+    EXPECT_LT(passes, 21) << "the limit, not the cap, should have ended it";
+    v1::JobSpec fixed = spec;
+    fixed.mutable_parameters()->set_time_limit_seconds(0.0);
+    fixed.mutable_parameters()->set_samples_per_pixel(spp);
+    expectBitIdentical(embeddedRender(fixed), image);
+}
+
 TEST(Service, AJobSurvivesAWorkerKilledMidJob) {
     Cluster cluster;
     const v1::JobSpec spec = makeSpec("path", 8, 11, 48, 32, 8);  // 24 tiles
@@ -209,7 +262,7 @@ TEST(Service, AWorkerOfAnotherProtocolVersionIsRefusedNamingBothVersions) {
     } catch (const worker::WorkerRefused& e) {
         const std::string message = e.what();
         EXPECT_NE(message.find("protocol 99"), std::string::npos) << message;
-        EXPECT_NE(message.find("protocol 1"), std::string::npos) << message;
+        EXPECT_NE(message.find("protocol " + std::to_string(rpc::kProtocolVersion)), std::string::npos) << message;
         EXPECT_NE(message.find(VRL_VERSION), std::string::npos) << message;
     }
     options.protocolVersion = rpc::kProtocolVersion;
@@ -426,6 +479,8 @@ TEST(Service, TileResultsAreTakenOnceAndCheckedBeforeMerging) {
             result.set_lease_id(l.lease_id());
             result.set_job_id(id);
             *result.mutable_tile() = l.tile();
+            result.set_first_pass(l.first_pass());
+            result.set_pass_count(l.pass_count());
             result.add_layers()->set_rgb(pixels.data(), bytes);
             return result;
         };
