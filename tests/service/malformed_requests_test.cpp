@@ -217,7 +217,7 @@ void submitJobCases(Harness& h) {
         // (An empty method is the headline method since step 9, not an error.)
         {"blank method", [&](S& s) { params(s).set_method(" "); }, StatusCode::INVALID_ARGUMENT, "unknown method ' '"},
         {"unknown method", [&](S& s) { params(s).set_method("magic"); }, StatusCode::INVALID_ARGUMENT,
-         "unknown method 'magic' (valid: path, vrl, vrl-lightcuts, vpl, vpl-lightcuts)"},
+         "unknown method 'magic' (valid: path, vrl, vrl-lightcuts, vrl-stochastic, vpl, vpl-lightcuts)"},
         {"100 kB method", [&](S& s) { params(s).set_method(std::string(100000, 'm')); }, StatusCode::INVALID_ARGUMENT,
          "unknown method"},
         {"empty bundle hash", [](S& s) { s.clear_bundle_sha256(); }, StatusCode::INVALID_ARGUMENT,

@@ -34,15 +34,15 @@ using T = xml::ParamType;
 using U = xml::ParamUse;
 // clang-format off
 // Integrators this renderer implements: the path tracer's Mitsuba names and
-// the rendering methods' own names (renderer.h: path, vrl, vrl-lightcuts, vpl,
-// vpl-lightcuts; a job with no method renders the one its scene names), then the
+// the rendering methods' own names (renderer.h: path, vrl, vrl-lightcuts,
+// vrl-stochastic, vpl, vpl-lightcuts; a job with no method renders the one its scene names), then the
 // other Mitsuba 0.5/0.6 integrators: accepted, their parameters listed in
 // SceneDescription::ignored, only maxDepth read.
 constexpr std::string_view kIntegratorTypes[] = {
-    "volpath", "volpath_simple", "path", "direct", "vrl", "vrlcuts", "vrl-lightcuts", "vpl", "vpl-lightcuts",
-    "ao", "bdpt", "photonmapper", "ppm", "sppm", "pssmlt", "mlt", "erpt", "ptracer",
+    "volpath", "volpath_simple", "path", "direct", "vrl", "vrlcuts", "vrl-lightcuts", "vrl-stochastic", "vpl",
+    "vpl-lightcuts", "ao", "bdpt", "photonmapper", "ppm", "sppm", "pssmlt", "mlt", "erpt", "ptracer",
     "adaptive", "irrcache", "multichannel", "field"};
-constexpr size_t kOwnIntegratorCount = 9;
+constexpr size_t kOwnIntegratorCount = 10;
 constexpr ParamSpec kIntegratorParameters[] = {
     {"maxDepth", T::Integer}, {"rrDepth", T::Integer, U::Ignore},
     {"strictNormals", T::Boolean, U::Ignore}, {"hideEmitters", T::Boolean, U::Ignore},
