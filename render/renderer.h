@@ -71,8 +71,6 @@ constexpr bool usesVpls(RenderMethod m) { return m == RenderMethod::Vpl || m == 
 constexpr bool usesLightTree(RenderMethod m) {
     return m == RenderMethod::VrlLightcuts || m == RenderMethod::VrlStochastic || m == RenderMethod::VplLightcuts;
 }
-// The method's parts (c), (d) are Monte Carlo estimates per camera sample (stochastic cuts).
-constexpr bool virtualLightsPerSample(RenderMethod m) { return m == RenderMethod::VrlStochastic; }
 // The method renders the four transport parts with virtual lights (every method but path).
 constexpr bool usesVirtualLights(RenderMethod m) { return m != RenderMethod::Path; }
 
