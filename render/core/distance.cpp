@@ -77,4 +77,13 @@ double distancePointSegment(const Vec3& point, const Vec3& a, const Vec3& b) {
     return (ap - ab * s).length();
 }
 
+std::pair<double, double> signedDistanceRange(const Imath::Box3f& box, const Vec3& n, const Vec3& x) {
+    double centre = 0.0, radius = 0.0;
+    for (int a = 0; a < 3; ++a) {
+        centre += double(n[a]) * (0.5 * (double(box.min[a]) + double(box.max[a])) - double(x[a]));
+        radius += std::abs(double(n[a])) * 0.5 * (double(box.max[a]) - double(box.min[a]));
+    }
+    return {centre - radius, centre + radius};
+}
+
 }  // namespace vrl

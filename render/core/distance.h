@@ -8,6 +8,8 @@
 
 #include <Imath/ImathBox.h>
 
+#include <utility>
+
 namespace vrl {
 
 // The largest angle a segment of length `segmentLength` subtends from a point at
@@ -18,6 +20,9 @@ double distanceLineBox(const Vec3& origin, const Vec3& direction, const Imath::B
 double distanceLineSegment(const Vec3& origin, const Vec3& direction, const Vec3& a, const Vec3& b);
 // Distance from a point to a box (0 inside it).
 double distancePointBox(const Vec3& point, const Imath::Box3f& box);
+// Smallest and largest of n.(q - x) over the points q of the box (n need not be
+// unit): the range of signed distances from the plane through x with normal n.
+std::pair<double, double> signedDistanceRange(const Imath::Box3f& box, const Vec3& n, const Vec3& x);
 // Distance from a point to the segment [a, b].
 double distancePointSegment(const Vec3& point, const Vec3& a, const Vec3& b);
 

@@ -20,16 +20,6 @@ float phaseMaximum(const PhaseFunction& phase) {
     return float((1.0 + g) / (4.0 * M_PI * (1.0 - g) * (1.0 - g)));
 }
 
-// Largest and smallest of n.(p - x) over the box.
-std::pair<double, double> linearRange(const Imath::Box3f& box, const Vec3& n, const Vec3& x) {
-    double centre = 0.0, radius = 0.0;
-    for (int a = 0; a < 3; ++a) {
-        centre += double(n[a]) * (0.5 * (double(box.min[a]) + double(box.max[a])) - double(x[a]));
-        radius += std::abs(double(n[a])) * 0.5 * (double(box.max[a]) - double(box.min[a]));
-    }
-    return {centre - radius, centre + radius};
-}
-
 }  // namespace
 
 SurfaceClusterBound::SurfaceClusterBound(const Scene& scene, const LightTree& tree, ClusterBoundSettings settings)
@@ -66,12 +56,12 @@ Rgb SurfaceClusterBound::bound(int32_t index, const CameraPathSurface& x, bool* 
     // Reflection only on wo's geometric side: a box wholly behind gives nothing.
     const bool reflectsOnly = bsdf.kind() != BsdfDescription::Kind::RoughDielectric;
     const float side = x.wo.dot(x.hit.geometricNormal) >= 0.0f ? 1.0f : -1.0f;
-    if (reflectsOnly && linearRange(node.box, x.hit.geometricNormal * side, p).second < -slack) return Rgb(0.0f);
+    if (reflectsOnly && signedDistanceRange(node.box, x.hit.geometricNormal * side, p).second < -slack) return Rgb(0.0f);
 
     Rgb fCos;
     const std::optional<Rgb> lambert = bsdf.lambertianBound(x.hit.uv);
     if (lambert) {
-        const auto [lo, hi] = linearRange(node.box, x.hit.shadingNormal, p);
+        const auto [lo, hi] = signedDistanceRange(node.box, x.hit.shadingNormal, p);
         const double cosine = std::min(1.0, (std::max(std::abs(lo), std::abs(hi)) + slack) / d);
         fCos = *lambert * float(cosine);
     } else {

@@ -18,15 +18,6 @@ double tinyDistance(const Vec3& p, const Imath::Box3f& box) {
     return 1e-6 * (1.0 + double(p.length()) + reach);
 }
 
-// Largest and smallest of n.(q - x) over the box (as surface_cluster_bound.cpp).
-std::pair<double, double> linearRange(const Imath::Box3f& box, const Vec3& n, const Vec3& x) {
-    double centre = 0.0, radius = 0.0;
-    for (int a = 0; a < 3; ++a) {
-        centre += double(n[a]) * (0.5 * (double(box.min[a]) + double(box.max[a])) - double(x[a]));
-        radius += std::abs(double(n[a])) * 0.5 * (double(box.max[a]) - double(box.min[a]));
-    }
-    return {centre - radius, centre + radius};
-}
 
 double largestChannel(const Rgb& c) { return double(std::max({c.x, c.y, c.z})); }
 
@@ -97,10 +88,10 @@ double VrlImportance::surface(int32_t index, const CameraPathSurface& x) const {
     const double tiny = tinyDistance(p, node.box);
     const float side = x.wo.dot(x.hit.geometricNormal) >= 0.0f ? 1.0f : -1.0f;
     // Wholly behind a reflecting surface (with the bound's rounding slack): exactly 0.
-    if (reflectsOnly && linearRange(node.box, x.hit.geometricNormal * side, p).second < -8.0 * tiny) return 0.0;
+    if (reflectsOnly && signedDistanceRange(node.box, x.hit.geometricNormal * side, p).second < -8.0 * tiny) return 0.0;
     const double dBox = distancePointBox(p, node.box);
     const double d = std::max({dBox, double(fraction_) * diagonal(node.box), tiny});
-    const auto [lo, hi] = linearRange(node.box, x.hit.shadingNormal, p);
+    const auto [lo, hi] = signedDistanceRange(node.box, x.hit.shadingNormal, p);
     const double cosine = std::clamp(std::max(std::abs(lo), std::abs(hi)) / std::max(dBox, tiny), 1e-3, 1.0);
     double transmittance = 1.0;
     if (node.medium >= 0 && node.medium == x.medium && reflectsOnly && !shape.changesMedium) {
