@@ -18,6 +18,18 @@
 //   st_eq_lc: the time vrl-stochastic needs to reach the Lightcuts error, and
 //     the Lightcuts time over it;
 //   #Eval (VRL estimates) and importances per pixel and sample.
+//
+// --truth measures against the *true* part instead (what a user wants): the
+// reference is the mean over --truth-sets independent VRL sets of
+// --truth-vrls VRLs, each shaded by vrl-stochastic at --truth-spp (unbiased for
+// the transport of its set, so the mean converges to the true part); its own
+// noise is estimated from two independent halves and printed beside it. Every
+// method then pays for its VRL set's error: plain VRLs and Lightcuts use one
+// set of N; vrl-stochastic runs with P = 1, 2, 4, ... fresh sets of N (each
+// traced and built inside the measured time) at 1, 2, 4, ... samples per pixel
+// per set, the image being the mean over the sets (what `vrl render --vrl-sets P`
+// does). Times there include light tracing and the tree build. No
+// extrapolation: the best measured point at or under each comparison time.
 // Timings are wall-clock, one run each, on whatever cores TBB gets: compare
 // ratios within one run, not seconds.
 #include "render/core/timing.h"
@@ -35,6 +47,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <stdexcept>
 
 using namespace vrl;
 
@@ -86,11 +99,138 @@ Shading shade(const Scene& scene, const VrlSet& vrls, const LightTree& tree, Met
 }
 
 Image mean(const std::vector<Image>& images) {
+    if (images.empty()) throw std::invalid_argument("mean of no images");
     Image out(images[0].width(), images[0].height());
     for (const Image& image : images)
         for (int y = 0; y < out.height(); ++y)
             for (int x = 0; x < out.width(); ++x) out.at(x, y) += image.at(x, y) / float(images.size());
     return out;
+}
+
+struct LightSet {
+    VrlSet vrls;
+    LightTree tree;
+    double seconds = 0.0;  // tracing and tree build
+};
+
+// Set k of N VRLs (its own light-tracing stream) and its tree.
+LightSet traceSet(const Scene& scene, int maxDepth, uint64_t n, uint64_t k, bool withTree) {
+    const auto start = std::chrono::steady_clock::now();
+    LightTracingSettings tracing;
+    tracing.targetVrls = n;
+    tracing.maxDepth = maxDepth;
+    tracing.seed = 0x9e3779b97f4a7c15ULL * (k + 1);
+    LightSet set;
+    set.vrls = traceVrls(scene, tracing);
+    if (withTree) set.tree = LightTree::build(set.vrls.vrls, LightTreeSettings{2048, k, false});
+    set.seconds = secondsSince(start);
+    return set;
+}
+
+struct TruthOptions {
+    uint64_t vrls = 1000000;
+    int sets = 8, spp = 32, cutSize = 32;
+};
+
+void runAgainstTruth(const Scene& scene, int maxDepth, const std::vector<uint64_t>& counts, float error,
+                     const std::vector<int>& cutSizes, double timeFactor, int maxSpp, int maxSets,
+                     const TruthOptions& truth, bool surfacePart) {
+    // The reference: two independent halves of the sets, whose difference gives its noise.
+    std::printf("reference: mean of %d sets of %zu VRLs, vrl-stochastic K %d at %d spp each\n", truth.sets,
+                size_t(truth.vrls), truth.cutSize, truth.spp);
+    std::fflush(stdout);
+    std::vector<Image> halves[2];
+    const auto referenceStart = std::chrono::steady_clock::now();
+    for (int k = 0; k < truth.sets; ++k) {
+        const LightSet set = traceSet(scene, maxDepth, truth.vrls, 1000 + uint64_t(k), true);
+        halves[k % 2].push_back(shade(scene, set.vrls, set.tree, Method::Stochastic, error, truth.cutSize, truth.spp, 1,
+                                      7000 + uint64_t(k), surfacePart)
+                                    .image);
+    }
+    std::vector<Image> all = halves[0];
+    all.insert(all.end(), halves[1].begin(), halves[1].end());
+    const Image reference = mean(all);
+    // Var(mean of all) = Var(half difference) / 4 for equal halves.
+    const double referenceNoise = 0.5 * compareImages(mean(halves[0]), mean(halves[1])).relativeRmse;
+    std::printf("reference built in %.1f s; its own noise (half the RMSE between its halves, relative): %.5f\n",
+                secondsSince(referenceStart), referenceNoise);
+    std::printf("errors: relative RMSE against the true part; a method error under 3x the reference noise is marked '~'\n");
+    const auto mark = [&](double e) { return e < 3.0 * referenceNoise ? "~" : " "; };
+    for (uint64_t n : counts) {
+        LightSet set = traceSet(scene, maxDepth, n, 0, true);
+        std::printf("\nN = %zu VRLs (trace + tree %.2f s)\n", set.vrls.vrls.size(), set.seconds);
+        const Shading plain = shade(scene, set.vrls, set.tree, Method::Plain, error, 1, 1, 1, 1, surfacePart);
+        const Shading cuts = shade(scene, set.vrls, set.tree, Method::Lightcuts, error, 1, 1, 1, 1, surfacePart);
+        const double plainError = compareImages(reference, plain.image).relativeRmse;
+        const double cutsError = compareImages(reference, cuts.image).relativeRmse;
+        const double plainTime = plain.seconds + set.seconds, cutsTime = cuts.seconds + set.seconds;
+        std::printf("  %-34s %9.3f s  relRMSE %.5f%s\n", "plain VRLs (one set)", plainTime, plainError, mark(plainError));
+        std::printf("  %-34s %9.3f s  relRMSE %.5f%s  #Eval %.0f per pixel\n", "VRL Lightcuts (one set)", cutsTime,
+                    cutsError, mark(cutsError), cuts.evaluated);
+        std::fflush(stdout);
+        for (const int cutSize : cutSizes) {
+            struct Point {
+                int sets, spp;
+                double seconds, error;
+            };
+            std::vector<Point> points;
+            for (int p = 1; p <= maxSets; p *= 2) {
+                std::vector<LightSet> sets;
+                double setup = 0.0;
+                for (int k = 0; k < p; ++k) {
+                    sets.push_back(k == 0 ? std::move(set) : traceSet(scene, maxDepth, n, uint64_t(k), true));
+                    setup += sets.back().seconds;
+                }
+                for (int spp = 1; spp <= maxSpp; spp *= 2) {
+                    std::vector<Image> images;
+                    double seconds = setup, evaluated = 0.0;
+                    for (int k = 0; k < p; ++k) {
+                        const Shading st = shade(scene, sets[size_t(k)].vrls, sets[size_t(k)].tree, Method::Stochastic,
+                                                 error, cutSize, spp, 1, 100 + uint64_t(k), surfacePart);
+                        images.push_back(st.image);
+                        seconds += st.seconds;
+                        evaluated += st.evaluated / p;
+                    }
+                    const double e = compareImages(reference, mean(images)).relativeRmse;
+                    points.push_back({p, spp, seconds, e});
+                    std::printf("  vrl-stochastic K %4d, %3d sets x %4d spp %9.3f s  relRMSE %.5f%s  #Eval %.1f per pixel and sample\n",
+                                cutSize, p, spp, seconds, e, mark(e), evaluated);
+                    std::fflush(stdout);
+                    if (seconds > timeFactor * cutsTime) break;
+                }
+                set = std::move(sets[0]);
+            }
+            // The best measured point within a time, and the fastest one within an error.
+            const auto bestWithin = [&](double seconds) -> const Point* {
+                const Point* best = nullptr;
+                for (const Point& q : points)
+                    if (q.seconds <= seconds && (!best || q.error < best->error)) best = &q;
+                return best;
+            };
+            const auto fastestTo = [&](double target) -> const Point* {
+                const Point* best = nullptr;
+                for (const Point& q : points)
+                    if (q.error <= target && (!best || q.seconds < best->seconds)) best = &q;
+                return best;
+            };
+            if (const Point* q = fastestTo(plainError))
+                std::printf("  st_eq_plain: %d sets x %d spp reach plain's error in %.3f s: plain VRLs take %.2fx that time\n",
+                            q->sets, q->spp, q->seconds, plainTime / q->seconds);
+            else
+                std::printf("  st_eq_plain: no measured point reaches plain's error\n");
+            if (const Point* q = bestWithin(cutsTime))
+                std::printf("  st_at_lc:    %d sets x %d spp: relRMSE %.5f in %.3f s <= the Lightcuts time (Lightcuts %.5f): %s\n",
+                            q->sets, q->spp, q->error, q->seconds, cutsError,
+                            q->error < cutsError ? "stochastic lower" : "Lightcuts lower");
+            else
+                std::printf("  st_at_lc:    no measured point within the Lightcuts time\n");
+            if (const Point* q = fastestTo(cutsError))
+                std::printf("  st_eq_lc:    %d sets x %d spp reach the Lightcuts error in %.3f s: VRL Lightcuts take %.2fx that time\n",
+                            q->sets, q->spp, q->seconds, cutsTime / q->seconds);
+            else
+                std::printf("  st_eq_lc:    no measured point reaches the Lightcuts error\n");
+        }
+    }
 }
 
 }  // namespace
@@ -110,6 +250,9 @@ int main(int argc, char** argv) {
     uint64_t strideAbove = 200000;
     int stride = 4;
     std::vector<std::string> defines;
+    bool againstTruth = false;
+    int maxSets = 16;
+    TruthOptions truth;
     app.add_option("--scene", scenePath, "Scene file (default scenes/smoke-room.xml)");
     app.add_option("-D,--define", defines, "Override a scene <default>: -D name=value (repeatable)");
     app.add_option("--vrls", counts, "VRL counts to run (default 10000 100000)");
@@ -126,6 +269,12 @@ int main(int argc, char** argv) {
     app.add_option("--stride", stride, "Pixel stride for large N (default 4: 1/16 of the pixels)");
     app.add_option("--part", part, "Transport part: multiple (d, default) or medium-surface (c)")
         ->check(CLI::IsMember({"multiple", "medium-surface"}));
+    app.add_flag("--truth", againstTruth, "Measure against the true part (many VRL sets), with fresh sets for vrl-stochastic");
+    app.add_option("--max-sets", maxSets, "--truth: most fresh VRL sets for vrl-stochastic (default 16)")->check(CLI::Range(1, 1024));
+    app.add_option("--truth-vrls", truth.vrls, "--truth: VRLs per reference set (default 1000000)");
+    app.add_option("--truth-sets", truth.sets, "--truth: reference sets, even (default 8)")->check(CLI::Range(2, 4096));
+    app.add_option("--truth-cut-size", truth.cutSize, "--truth: K of the reference's vrl-stochastic (default 32)")->check(CLI::Range(1, 1 << 20));
+    app.add_option("--truth-spp", truth.spp, "--truth: vrl-stochastic spp per reference set (default 32)")->check(CLI::Range(1, 1 << 20));
     CLI11_PARSE(app, argc, argv);
     const bool surfacePart = part == "medium-surface";
 
@@ -149,6 +298,11 @@ int main(int argc, char** argv) {
     const auto scene = Scene::build(description);
     std::printf("scene %s, %dx%d, part %s, Lightcuts error %.3f\n", scenePath.c_str(), w, h,
                 surfacePart ? "(c)" : "(d)", error);
+    if (againstTruth) {
+        runAgainstTruth(*scene, description.integrator.maxDepth, counts, error, cutSizes, timeFactor, maxSpp, maxSets,
+                        truth, surfacePart);
+        return 0;
+    }
     std::printf("errors: relative RMSE against the same VRL set's converged part (mean of %d plain renders)\n",
                 referenceRuns);
     for (uint64_t n : counts) {

@@ -225,6 +225,9 @@ int runRender(const RenderCommandOptions& o, const CLI::App& command) {
                      stats.tracingSeconds, (unsigned long long)stats.lightPaths, (unsigned long long)stats.vrlCount,
                      usesVpls(settings.method) ? "VPLs" : "VRLs",
                      double(stats.vrlBytes) / (1024.0 * 1024.0), sizeof(Vrl));
+        if (settings.vrlSets > 1)
+            std::fprintf(stderr, "  %d independent VRL sets (counts above are over all of them); sample s uses set s mod %d\n",
+                         settings.vrlSets, settings.vrlSets);
         std::fprintf(stderr, "  transport parts: %s\n", settings.transports.toString().c_str());
     }
     if (usesLightTree(settings.method)) {

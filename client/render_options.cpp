@@ -116,6 +116,10 @@ void addRenderOptions(CLI::App& cmd, RenderCommandOptions& o) {
                    "vrl-stochastic: nodes per stochastic cut, one VRL drawn under each (per camera segment and surface "
                    "point, per sample; default 32)")
         ->check(CLI::Range(1u, 1u << 20));
+    cmd.add_option("--vrl-sets", o.vrlSets,
+                   "vrl-stochastic: independent VRL sets of --vrls each (own light paths, own trees); camera sample s "
+                   "uses set s mod this, so the image converges to the true transport, not one set's (default 1)")
+        ->check(CLI::Range(1u, uint32_t(kMaxVrlSets)));
     cmd.add_flag("--pixel-centres", o.pixelCentres,
                  "Camera rays through pixel centres, the paper's setting (default: jittered inside each pixel, "
                  "antialiased, as Mitsuba and pbrt do; still bit-identical across threads and workers)");
@@ -160,11 +164,12 @@ void checkLightMemory(const RenderSettings& settings, uint64_t memoryBytes) {
     if (need <= memoryBytes) return;
     char message[512];
     std::snprintf(message, sizeof message,
-                  "--vrls %llu: the %s and their light structures need about %.1f GiB (%.0f bytes each), more than "
-                  "this machine's %.1f GiB of memory; lower --vrls",
-                  (unsigned long long)settings.vrlCount, usesVpls(settings.method) ? "VPLs" : "VRLs",
-                  double(need) / double(1ull << 30), double(need) / double(std::max<uint64_t>(1, settings.vrlCount)),
-                  double(memoryBytes) / double(1ull << 30));
+                  "--vrls %llu%s: the %s and their light structures need about %.1f GiB (%.0f bytes each), more than "
+                  "this machine's %.1f GiB of memory; lower --vrls%s",
+                  (unsigned long long)settings.vrlCount, settings.vrlSets > 1 ? " in each VRL set" : "",
+                  usesVpls(settings.method) ? "VPLs" : "VRLs", double(need) / double(1ull << 30),
+                  double(need) / (double(std::max<uint64_t>(1, settings.vrlCount)) * std::max(1, settings.vrlSets)),
+                  double(memoryBytes) / double(1ull << 30), settings.vrlSets > 1 ? " or --vrl-sets" : "");
     throw std::invalid_argument(message);
 }
 
@@ -227,6 +232,7 @@ v1::RenderParameters toRenderParameters(const RenderCommandOptions& o) {
     p.set_hg_epsilon(o.hgEpsilon);
     p.set_partition_size(o.partitionSize);
     p.set_cut_size(o.cutSize);
+    p.set_vrl_sets(o.vrlSets);
     return p;
 }
 

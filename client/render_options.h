@@ -41,6 +41,7 @@ struct RenderCommandOptions {
     float hgEpsilon = 1.0f;
     uint32_t partitionSize = 2048;
     uint32_t cutSize = 32;  // vrl-stochastic
+    uint32_t vrlSets = 1;   // vrl-stochastic
     // Distributed rendering (render --workers, submit)
     int workers = 0;       // render: 0 embedded, N: a local coordinator and N worker processes
     uint32_t tileSize = 32;

@@ -46,6 +46,7 @@ void writeRenderMetadata(const RenderRecord& record, const PerspectiveCamera& ca
     if (usesLightTree(s.method)) {
         if (s.method == RenderMethod::VrlStochastic) {
             metadata["vrl.cutSize"] = int32_t(s.cut.stochasticCutSize);
+            metadata["vrl.vrlSets"] = int32_t(s.vrlSets);  // vrl.vrls and vrl.lightPaths count all sets
         } else {
             metadata["vrl.error"] = s.cut.errorThreshold;
             metadata["vrl.maxCut"] = int32_t(s.cut.maxCutSize);

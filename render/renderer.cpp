@@ -81,6 +81,14 @@ void validateRenderSettings(const RenderSettings& settings) {
     if (settings.cut.stochasticCutSize < 1 || settings.cut.stochasticCutSize > (1u << 20))
         throw std::invalid_argument("the stochastic cut size must be in [1, 1048576], not " +
                                     std::to_string(settings.cut.stochasticCutSize));
+    if (settings.vrlSets < 1 || settings.vrlSets > kMaxVrlSets)
+        throw std::invalid_argument("the VRL sets must be in [1, " + std::to_string(kMaxVrlSets) + "], not " +
+                                    std::to_string(settings.vrlSets));
+    if (settings.vrlSets > 1 && settings.method != RenderMethod::VrlStochastic)
+        throw std::invalid_argument("several VRL sets (" + std::to_string(settings.vrlSets) +
+                                    ") need the vrl-stochastic method, which draws its VRLs per camera sample; " +
+                                    std::string(methodName(settings.method)) +
+                                    " shades a whole set per pixel (ask for more --vrls instead)");
     if (!(settings.timeLimitSeconds >= 0.0 && settings.timeLimitSeconds <= kMaxTimeLimitSeconds))
         throw std::invalid_argument("the time limit must be 0 (none) or a number of seconds up to " +
                                     std::to_string(int64_t(kMaxTimeLimitSeconds)) + ", got " +
@@ -94,29 +102,52 @@ RenderLights prepareLights(const Scene& scene, const RenderSettings& settings, c
     if (!needsLights(settings)) return lights;
     RenderStatistics local;
     RenderStatistics& stats = statistics ? *statistics : local;
-    LightTracingSettings tracing;
-    tracing.lightPaths = settings.lightPaths;
-    tracing.targetVrls = settings.vrlCount;
-    tracing.maxDepth = settings.maxDepth;
-    tracing.seed = settings.seed ^ 0x5bd1e995ULL;  // a stream family apart from the camera's
     const bool points = usesVpls(settings.method);
-    if (points) tracing.deposit = LightDeposit::Points;
-    lights.vrls = traceVrls(scene, tracing, [&](double f) {
-        if (progress) progress("light tracing", f);
-    });
-    stats.vrlCount = lights.vrls.vrls.size();
-    stats.lightPaths = lights.vrls.lightPaths;
-    stats.vrlBytes = lights.vrls.memoryBytes();
-    stats.tracingSeconds = lights.vrls.tracingSeconds;
-    if (usesLightTree(settings.method) && !lights.vrls.vrls.empty()) {
+    const int sets = settings.vrlSets;
+    const uint64_t firstSeed = settings.seed ^ 0x5bd1e995ULL;  // a stream family apart from the camera's
+    stats.vrlCount = stats.lightPaths = 0;
+    stats.vrlBytes = 0;
+    stats.tracingSeconds = stats.treeSeconds = 0.0;
+    stats.treeBytes = 0;
+    stats.vrlSets = sets;
+    for (int k = 0; k < sets; ++k) {
+        LightTracingSettings tracing;
+        tracing.lightPaths = settings.lightPaths;
+        tracing.targetVrls = settings.vrlCount;
+        tracing.maxDepth = settings.maxDepth;
+        tracing.seed = k == 0 ? firstSeed : Rng::combine(firstSeed, uint64_t(k));  // set 0: as with one set
+        if (points) tracing.deposit = LightDeposit::Points;
+        const std::string tracingPhase = sets == 1 ? std::string("light tracing")
+                                                   : "light tracing (set " + std::to_string(k + 1) + " of " +
+                                                         std::to_string(sets) + ")";
+        VrlSet set = traceVrls(scene, tracing, [&](double f) {
+            if (progress) progress(tracingPhase.c_str(), f);
+        });
+        stats.vrlCount += set.vrls.size();
+        stats.lightPaths += set.lightPaths;
+        stats.vrlBytes += set.memoryBytes();
+        stats.tracingSeconds += set.tracingSeconds;
+        if (!usesLightTree(settings.method) || set.vrls.empty()) {
+            // Without a tree there is one set (validateRenderSettings); an empty set keeps its place.
+            if (k == 0)
+                lights.vrls = std::move(set);
+            else
+                lights.moreTrees.emplace_back();
+            continue;
+        }
         if (progress) progress("building the light tree", 0.0);
         const auto treeStart = std::chrono::steady_clock::now();
         // The tree takes the VRLs over: shading reads them from it.
-        lights.tree = LightTree::build(std::move(lights.vrls.vrls),
-                                       LightTreeSettings{settings.partitionSize, settings.seed, points});
-        lights.vrls.vrls = {};
-        stats.treeSeconds = secondsSince(treeStart);
-        stats.treeBytes = lights.tree.memoryBytes();
+        LightTree tree = LightTree::build(std::move(set.vrls), LightTreeSettings{settings.partitionSize, settings.seed, points});
+        stats.treeSeconds += secondsSince(treeStart);
+        stats.treeBytes += tree.memoryBytes();
+        if (k == 0) {
+            lights.vrls.lightPaths = set.lightPaths;
+            lights.vrls.tracingSeconds = set.tracingSeconds;
+            lights.tree = std::move(tree);
+        } else {
+            lights.moreTrees.push_back(std::move(tree));
+        }
         if (progress) progress("building the light tree", 1.0);
     }
     return lights;
@@ -129,7 +160,7 @@ uint64_t estimateLightMemoryBytes(const RenderSettings& settings) {
     // build scratch (packed boxes, freed once it is built).
     double perLight = 2.0 * sizeof(Vrl);
     if (usesLightTree(settings.method)) perLight += 2.0 * sizeof(LightTreeNode) + double(LightTree::buildScratchBytesPerVrl());
-    const double bytes = perLight * double(settings.vrlCount);
+    const double bytes = perLight * double(settings.vrlCount) * double(std::max(1, settings.vrlSets));
     return bytes >= 1.8e19 ? ~uint64_t(0) : uint64_t(bytes);
 }
 
@@ -172,11 +203,15 @@ void checkLightsMatchScene(const Scene& scene, const RenderLights& lights) {
                                             std::to_string(media) + " media: the lights do not belong to this scene");
     };
     check(lights.vrls.vrls);
-    check(lights.tree.vrls());
-    for (const LightTreeNode& node : lights.tree.nodes())
-        if (node.medium < -1 || node.medium >= int32_t(media))
-            throw std::invalid_argument("a light-tree node names medium " + std::to_string(node.medium) +
-                                        " but the scene has " + std::to_string(media) + " media");
+    const auto checkTree = [&](const LightTree& tree) {
+        check(tree.vrls());
+        for (const LightTreeNode& node : tree.nodes())
+            if (node.medium < -1 || node.medium >= int32_t(media))
+                throw std::invalid_argument("a light-tree node names medium " + std::to_string(node.medium) +
+                                            " but the scene has " + std::to_string(media) + " media");
+    };
+    checkTree(lights.tree);
+    for (const LightTree& tree : lights.moreTrees) checkTree(tree);
 }
 
 }  // namespace
@@ -194,6 +229,13 @@ TileShader::TileShader(const Scene& scene, const RenderSettings& settings, const
         integrator_ = std::make_unique<TransportIntegrator>(scene, lights.vrls, integratorSettings,
                                                       lightcuts && lights.tree.root() >= 0 ? &lights.tree : nullptr);
         lightsPerSample_ = integrator_->virtualLightsPerSample();
+        // Sets 1 ... P-1 (vrl-stochastic): each set's tree, or none when its light tracing found no VRL.
+        if (lights.moreTrees.size() + 1 != size_t(settings.vrlSets) && (lights.tree.root() >= 0 || !lights.moreTrees.empty()))
+            throw std::invalid_argument("the lights hold " + std::to_string(1 + lights.moreTrees.size()) +
+                                        " VRL sets but the render asks for " + std::to_string(settings.vrlSets));
+        for (const LightTree& tree : lights.moreTrees)
+            moreIntegrators_.push_back(std::make_unique<TransportIntegrator>(
+                scene, lights.vrls, integratorSettings, tree.root() >= 0 ? &tree : nullptr));
     } else {
         tracer_ = std::make_unique<VolumetricPathTracer>(scene, PathTracerSettings{settings.maxDepth});
     }
@@ -286,7 +328,10 @@ TileSums TileShader::shadeTile(const TileRect& tile, int firstPass, int passCoun
                     if (s == 0) firstSampleLuminance = pathLuminance;
                     CutStatistics cut, surfaceCut;
                     if (lightsPerSample_) {
-                        const auto lit = integrator_->virtualLightParts(ray, rng, &cut, &surfaceCut, pathLuminance);
+                        // Sample s draws from VRL set s mod P (set 0: integrator_).
+                        const size_t set = size_t(s) % (moreIntegrators_.size() + 1);
+                        const TransportIntegrator& lighting = set == 0 ? *integrator_ : *moreIntegrators_[set - 1];
+                        const auto lit = lighting.virtualLightParts(ray, rng, &cut, &surfaceCut, pathLuminance);
                         if (integrator_->vrlLitSurfaces()) parts[size_t(TransportPart::MediumSurface)] = lit.mediumSurface;
                         parts[size_t(TransportPart::Multiple)] = lit.multiple;
                         out.sums.boundExceeded += cut.boundExceeded + surfaceCut.boundExceeded;

@@ -74,6 +74,9 @@ constexpr bool usesLightTree(RenderMethod m) {
 // The method renders the four transport parts with virtual lights (every method but path).
 constexpr bool usesVirtualLights(RenderMethod m) { return m != RenderMethod::Path; }
 
+// The most independent VRL sets a render takes (RenderSettings::vrlSets).
+inline constexpr int kMaxVrlSets = 1024;
+
 // The longest time limit a render takes (about 116 days): a guard against typos such as 1e30.
 inline constexpr double kMaxTimeLimitSeconds = 1e7;
 
@@ -97,6 +100,11 @@ struct RenderSettings {
     CutSettings cut;             // error threshold, maximum cut, bound parameters
     int vplDistanceSamples = 32;  // vpl-lightcuts: stratified distance samples per camera segment
     uint32_t partitionSize = 2048;  // light tree: VRLs per partition of the median-split phase
+    // vrl-stochastic only: independent VRL sets of vrlCount VRLs each (own light-tracing
+    // streams, own trees); camera sample s uses set s mod vrlSets, so the image converges
+    // to the true transport rather than to one set's. Set 0 is the set of vrlSets = 1:
+    // with one sample per pixel the image does not depend on vrlSets.
+    int vrlSets = 1;
 };
 
 struct RenderStatistics {
@@ -105,8 +113,9 @@ struct RenderStatistics {
     int samplesPerPixel = 0;  // of the image (a progressive render: of its completed passes)
     int passes = 0;           // sample passes in the image (sample_passes.h)
     // vrl method
-    uint64_t vrlCount = 0;
-    uint64_t lightPaths = 0;
+    uint64_t vrlCount = 0;    // over all VRL sets
+    uint64_t lightPaths = 0;  // over all VRL sets
+    int vrlSets = 0;          // traced sets (RenderSettings::vrlSets; 0 when none)
     size_t vrlBytes = 0;
     double tracingSeconds = 0.0;
     // vrl-lightcuts method
@@ -123,22 +132,26 @@ struct RenderStatistics {
 using ProgressCallback = std::function<void(const char* phase, double fraction)>;
 
 // Checks the settings; throws std::invalid_argument for a non-positive sample
-// count, a negative error threshold or a negative or non-finite time limit.
+// count, a negative error threshold, a negative or non-finite time limit, or
+// vrlSets outside [1, kMaxVrlSets] or above 1 for another method than vrl-stochastic.
 void validateRenderSettings(const RenderSettings& settings);
 
 // The per-image light work of a render (the coordinator's part in the service):
 // the VRLs of the `vrl` method, or the light tree of `vrl-lightcuts` (which owns
 // its VRLs). Empty for the path tracer and when neither part (c) nor (d) is selected.
+// vrl-stochastic with vrlSets P > 1: `tree` is set 0's and moreTrees sets 1 ... P-1.
 struct RenderLights {
     VrlSet vrls;
     LightTree tree;
+    std::vector<LightTree> moreTrees;
 };
 RenderLights prepareLights(const Scene& scene, const RenderSettings& settings, const ProgressCallback& progress = {},
                            RenderStatistics* statistics = nullptr);
 
 // Peak memory of prepareLights for `settings` (0 when it prepares nothing): the
 // target VRL (or VPL) count times the bytes of a light, with the light tracer's
-// batch growth, plus the tree's nodes and build scratch for the tree methods.
+// batch growth, plus the tree's nodes and build scratch for the tree methods,
+// times the VRL sets.
 // With --light-paths the count is not known in advance and this returns 0.
 uint64_t estimateLightMemoryBytes(const RenderSettings& settings);
 
@@ -212,7 +225,8 @@ private:
     std::vector<std::string> layerNames_;
     std::vector<uint8_t> layerPerPixel_;
     bool lightsPerSample_ = false;
-    std::unique_ptr<class TransportIntegrator> integrator_;
+    std::unique_ptr<class TransportIntegrator> integrator_;  // set 0's (and the path-sampled parts)
+    std::vector<std::unique_ptr<class TransportIntegrator>> moreIntegrators_;  // sets 1 ... vrlSets - 1
     std::unique_ptr<class VolumetricPathTracer> tracer_;
 };
 

@@ -53,7 +53,12 @@ PreparedJob JobPreparation::prepare(const Job& job, const ProgressCallback& prog
         if (statistics.treeSeconds > 0.0) phases.emplace_back(kLightTreePhase, statistics.treeSeconds);
     }
     t0 = Clock::now();
-    if (lights.tree.root() >= 0) {
+    if (!lights.moreTrees.empty()) {  // vrl-stochastic with several VRL sets: all their trees in one blob
+        std::vector<const LightTree*> trees{&lights.tree};
+        for (const LightTree& tree : lights.moreTrees) trees.push_back(&tree);
+        const auto bytes = serializeLightTrees(trees);
+        prepared.lights = std::make_shared<const std::string>(bytes.begin(), bytes.end());
+    } else if (lights.tree.root() >= 0) {
         const auto bytes = serializeLightTree(lights.tree);
         prepared.lights = std::make_shared<const std::string>(bytes.begin(), bytes.end());
     } else if (!lights.vrls.vrls.empty()) {

@@ -243,10 +243,20 @@ std::shared_ptr<const Worker::JobContext> Worker::loadJob(const std::string& job
         if (!assets.lights_sha256().empty()) {
             const std::string blob = fetcher_->fetch(assets.lights_sha256(), assets.lights_size());
             const auto* data = reinterpret_cast<const uint8_t*>(blob.data());
-            if (usesLightTree(context->scene.settings.method))
+            if (context->scene.settings.vrlSets > 1) {  // vrl-stochastic: one tree per VRL set
+                std::vector<LightTree> trees = deserializeLightTrees(data, blob.size());
+                if (trees.size() != size_t(context->scene.settings.vrlSets))
+                    throw std::runtime_error("the job's lights hold " + std::to_string(trees.size()) +
+                                             " VRL sets, but its spec asks for " +
+                                             std::to_string(context->scene.settings.vrlSets));
+                context->lights.tree = std::move(trees[0]);
+                context->lights.moreTrees.assign(std::make_move_iterator(trees.begin() + 1),
+                                                 std::make_move_iterator(trees.end()));
+            } else if (usesLightTree(context->scene.settings.method)) {
                 context->lights.tree = deserializeLightTree(data, blob.size());
-            else
+            } else {
                 context->lights.vrls = deserializeVrlSet(data, blob.size());
+            }
         }
         context->shader = std::make_unique<TileShader>(*context->scene.scene, context->scene.settings, context->lights);
         if (context->shader->layerNames() != std::vector<std::string>(assets.layer_names().begin(), assets.layer_names().end()))

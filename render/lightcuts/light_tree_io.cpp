@@ -13,6 +13,8 @@ namespace vrl {
 namespace {
 
 constexpr char kMagic[8] = {'V', 'R', 'L', 'T', 'R', 'E', 'E', '\0'};
+constexpr char kTreesMagic[8] = {'V', 'R', 'L', 'T', 'R', 'E', 'E', 'S'};
+constexpr size_t kTreesHeaderBytes = 8 + 2 * 4;  // magic, version, count
 constexpr char kSetMagic[8] = {'V', 'R', 'L', 'S', 'E', 'T', '\0', '\0'};
 constexpr size_t kSetHeaderBytes = 8 + 4 * 4;  // magic, version, count, light paths (2 x u32)
 constexpr size_t kHeaderBytes = 8 + 4 * 4;  // magic, version, vrl count, node count, root
@@ -213,6 +215,77 @@ VrlSet deserializeVrlSet(const uint8_t* data, size_t size) {
     set.vrls.resize(count);
     for (Vrl& v : set.vrls) v = readVrl(in);
     return set;
+}
+
+std::vector<uint8_t> serializeLightTrees(const std::vector<const LightTree*>& trees) {
+    if (trees.empty() || trees.size() > kMaxLightTreesInBlob)
+        throw std::invalid_argument("serializeLightTrees: 1 ... " + std::to_string(kMaxLightTreesInBlob) +
+                                    " trees, not " + std::to_string(trees.size()));
+    std::vector<std::vector<uint8_t>> blobs;
+    size_t total = kTreesHeaderBytes + 8 * trees.size() + kCrcBytes;
+    for (const LightTree* tree : trees) {
+        blobs.push_back(serializeLightTree(*tree));
+        total += blobs.back().size();
+    }
+    Writer out(total);
+    out.bytes().insert(out.bytes().end(), std::begin(kTreesMagic), std::end(kTreesMagic));
+    out.u32(kLightTreeFormatVersion);
+    out.u32(static_cast<uint32_t>(trees.size()));
+    for (const auto& blob : blobs) {
+        out.u32(static_cast<uint32_t>(blob.size()));
+        out.u32(static_cast<uint32_t>(uint64_t(blob.size()) >> 32));
+    }
+    for (const auto& blob : blobs) out.bytes().insert(out.bytes().end(), blob.begin(), blob.end());
+    out.u32(util::crc32Of(out.bytes().data(), out.bytes().size()));
+    return std::move(out.bytes());
+}
+
+std::vector<LightTree> deserializeLightTrees(const uint8_t* data, size_t size) {
+    if (size > 0 && data == nullptr) throw std::invalid_argument("deserializeLightTrees: null data");
+    if (size < kTreesHeaderBytes + kCrcBytes || std::memcmp(data, kTreesMagic, sizeof kTreesMagic) != 0)
+        throw std::runtime_error("not a blob of VRL light trees (too short, or it does not start with \"VRLTREES\")");
+    Reader header(data + sizeof kTreesMagic, kTreesHeaderBytes - sizeof kTreesMagic);
+    const uint32_t version = header.u32();
+    if (version != kLightTreeFormatVersion)
+        throw std::runtime_error("light trees blob has format version " + std::to_string(version) +
+                                 " but this build reads version " + std::to_string(kLightTreeFormatVersion));
+    const uint32_t count = header.u32();
+    if (count < 1 || count > kMaxLightTreesInBlob)
+        throw std::runtime_error("light trees blob declares " + std::to_string(count) + " trees, outside 1 ... " +
+                                 std::to_string(kMaxLightTreesInBlob));
+    const uint64_t sizesEnd = kTreesHeaderBytes + 8 * uint64_t(count);
+    if (size < sizesEnd + kCrcBytes)
+        throw std::runtime_error("light trees blob is truncated: its " + std::to_string(count) +
+                                 " tree sizes need " + std::to_string(sizesEnd + kCrcBytes) + " bytes, found " +
+                                 std::to_string(size));
+    Reader sizes(data + kTreesHeaderBytes, 8 * size_t(count));
+    std::vector<uint64_t> treeBytes(count);
+    uint64_t expected = sizesEnd + kCrcBytes;
+    for (uint64_t& bytes : treeBytes) {
+        const uint64_t low = sizes.u32(), high = sizes.u32();
+        bytes = low | (high << 32);
+        if (bytes > size) throw std::runtime_error("light trees blob is corrupt: a tree size exceeds the blob");
+        expected += bytes;
+    }
+    if (expected != size)
+        throw std::runtime_error("light trees blob has the wrong size: its header declares " + std::to_string(expected) +
+                                 " bytes, found " + std::to_string(size));
+    const uint32_t storedCrc = Reader(data + size - kCrcBytes, kCrcBytes).u32();
+    if (storedCrc != util::crc32Of(data, size - kCrcBytes))
+        throw std::runtime_error("light trees blob is corrupt: checksum mismatch");
+    std::vector<LightTree> trees;
+    trees.reserve(count);
+    size_t offset = sizesEnd;
+    for (uint32_t k = 0; k < count; ++k) {
+        try {
+            trees.push_back(deserializeLightTree(data + offset, treeBytes[k]));
+        } catch (const std::runtime_error& e) {
+            throw std::runtime_error("light tree " + std::to_string(k) + " of " + std::to_string(count) + ": " +
+                                     e.what());
+        }
+        offset += treeBytes[k];
+    }
+    return trees;
 }
 
 }  // namespace vrl

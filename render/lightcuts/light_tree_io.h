@@ -51,4 +51,15 @@ std::vector<uint8_t> serializeVrlSet(const VrlSet& set);
 // checksum mismatch) like deserializeLightTree.
 VrlSet deserializeVrlSet(const uint8_t* data, size_t size);
 
+// Several independent trees in one blob (vrl-stochastic with --vrl-sets P, renderer.h):
+//   magic "VRLTREES", version u32 (kLightTreeFormatVersion), count u32 (1 ... kMaxLightTreesInBlob),
+//   count x size u64, then the count tree blobs (serializeLightTree) back to back, crc u32
+//   over every byte before it.
+inline constexpr uint32_t kMaxLightTreesInBlob = 1024;
+std::vector<uint8_t> serializeLightTrees(const std::vector<const LightTree*>& trees);
+// The inverse; throws std::runtime_error like deserializeLightTree (wrong magic or version,
+// a count out of range, sizes that do not add up to the blob, a checksum mismatch), and
+// with the tree's index for a tree that deserializeLightTree refuses.
+std::vector<LightTree> deserializeLightTrees(const uint8_t* data, size_t size);
+
 }  // namespace vrl

@@ -77,6 +77,7 @@ v1::RenderParameters defaultRenderParameters(RenderMethod method) {
     p.set_hg_epsilon(d.cut.bound.anisotropyEpsilon);
     p.set_partition_size(d.partitionSize);
     p.set_cut_size(d.cut.stochasticCutSize);
+    p.set_vrl_sets(uint32_t(d.vrlSets));
     return p;
 }
 
@@ -122,6 +123,13 @@ void validateJobSpec(const v1::JobSpec& spec, const ServiceLimits& limits) {
     if (p.cut_size() > (1u << 20))
         throw JobSpecError("the stochastic cut size must be in 1..." + std::to_string(1u << 20) +
                            " (0: the default), got " + std::to_string(p.cut_size()));
+    if (p.vrl_sets() > uint32_t(kMaxVrlSets))
+        throw JobSpecError("the VRL sets must be in 1..." + std::to_string(kMaxVrlSets) + " (0: one), got " +
+                           std::to_string(p.vrl_sets()));
+    if (p.vrl_sets() > 1 && (p.vrl_count() > limits.maxVrls / p.vrl_sets() || p.light_paths() > limits.maxVrls / p.vrl_sets()))
+        throw JobSpecError("the job asks for " + std::to_string(p.vrl_sets()) + " VRL sets of " +
+                           std::to_string(std::max(p.vrl_count(), p.light_paths())) + " VRLs or light paths, more than " +
+                           std::to_string(limits.maxVrls) + " in all, this coordinator's limit");
     if (p.exact_distance_below() > (1u << 20))
         throw JobSpecError("exact distance below must be in 0..." + std::to_string(1u << 20) + ", got " +
                            std::to_string(p.exact_distance_below()));
@@ -211,7 +219,12 @@ ResolvedJob resolveJob(const std::filesystem::path& sceneFile, const v1::JobSpec
     s.cut.bound.anisotropyEpsilon = p.hg_epsilon();
     s.partitionSize = p.partition_size();
     if (p.cut_size() > 0) s.cut.stochasticCutSize = p.cut_size();
-    validateRenderSettings(s);
+    s.vrlSets = p.vrl_sets() > 0 ? int(p.vrl_sets()) : 1;
+    try {
+        validateRenderSettings(s);
+    } catch (const std::invalid_argument& e) {
+        throw JobSpecError(e.what());  // settings that no method takes (several VRL sets but not vrl-stochastic, ...)
+    }
     return job;
 }
 

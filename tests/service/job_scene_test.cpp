@@ -107,6 +107,33 @@ TEST(ResolveJob, ATimeLimitMakesTheSampleCountACap) {
     }
 }
 
+TEST(ResolveJob, VrlSetsAreForVrlStochasticWithinTheVrlLimit) {
+    const test::TempDir dir("vrl-job-scene");
+    const auto scene = writeScene(dir, "");
+    v1::JobSpec spec = specWithMethod("vrl-stochastic");
+    spec.mutable_parameters()->set_vrl_count(1000);
+    EXPECT_EQ(rpc::resolveJob(scene, spec, {}).settings.vrlSets, 1);  // 0: one set
+    spec.mutable_parameters()->set_vrl_sets(5);
+    EXPECT_EQ(rpc::resolveJob(scene, spec, {}).settings.vrlSets, 5);
+    const auto rejects = [&](const v1::JobSpec& bad, const rpc::ServiceLimits& limits, const std::string& words) {
+        try {
+            rpc::resolveJob(scene, bad, limits);
+            ADD_FAILURE() << "accepted: " << bad.ShortDebugString();
+        } catch (const rpc::JobSpecError& e) {
+            EXPECT_NE(std::string(e.what()).find(words), std::string::npos) << e.what();
+        }
+    };
+    v1::JobSpec tooMany = spec;
+    tooMany.mutable_parameters()->set_vrl_sets(uint32_t(kMaxVrlSets) + 1);
+    rejects(tooMany, {}, "VRL sets must be in 1..." + std::to_string(kMaxVrlSets));
+    rpc::ServiceLimits limits;
+    limits.maxVrls = 4000;  // 5 sets of 1000 VRLs are over it, one set is not
+    rejects(spec, limits, "5 VRL sets of 1000");
+    v1::JobSpec lightcuts = spec;
+    lightcuts.mutable_parameters()->set_method("vrl-lightcuts");
+    rejects(lightcuts, {}, "need the vrl-stochastic method");
+}
+
 TEST(ResolveJob, CropAppliesAfterTheResolution) {
     const test::TempDir dir("vrl-job-scene");
     const auto scene = writeScene(dir, "");

@@ -243,5 +243,113 @@ TEST(LightTreeIo, RejectsStructurallyInvalidTreeWithValidChecksum) {
     expectRejected(blob, {"structurally invalid", "out of range"});
 }
 
+// ---- several trees in one blob (vrl-stochastic with --vrl-sets)
+
+// Expects deserializeLightTrees to throw std::runtime_error naming every one of `parts`.
+void expectTreesRejected(const std::vector<uint8_t>& blob, const std::vector<std::string>& parts,
+                         const std::string& context = "") {
+    try {
+        deserializeLightTrees(blob.data(), blob.size());
+        ADD_FAILURE() << "accepted a bad blob " << context;
+    } catch (const std::runtime_error& e) {
+        for (const std::string& part : parts)
+            EXPECT_NE(std::string(e.what()).find(part), std::string::npos)
+                << "message \"" << e.what() << "\" lacks \"" << part << "\" " << context;
+    }
+}
+
+std::vector<LightTree> threeTrees() {
+    Rng rng(99, 3);
+    std::vector<LightTree> trees;
+    trees.push_back(smallTree());
+    trees.push_back(LightTree());  // a set whose light tracing found no VRL keeps its place
+    trees.push_back(makeTree({randomVrl(rng), randomVrl(rng)}, {{0, 1}}));
+    return trees;
+}
+
+std::vector<uint8_t> threeTreesBlob() {
+    const std::vector<LightTree> trees = threeTrees();
+    return serializeLightTrees({&trees[0], &trees[1], &trees[2]});
+}
+
+TEST(LightTreesIo, SeveralTreesRoundTripBitExactlyInOrder) {
+    const std::vector<LightTree> trees = threeTrees();
+    const std::vector<uint8_t> blob = threeTreesBlob();
+    // Header (magic, version, count), three u64 sizes, the three tree blobs, the CRC.
+    size_t expected = 8 + 4 + 4 + 3 * 8 + 4;
+    for (const LightTree& tree : trees) expected += serializeLightTree(tree).size();
+    EXPECT_EQ(blob.size(), expected);
+    const std::vector<LightTree> back = deserializeLightTrees(blob.data(), blob.size());
+    ASSERT_EQ(back.size(), 3u);
+    for (size_t k = 0; k < 3; ++k) expectSameTree(trees[k], back[k]);
+    EXPECT_TRUE(back[1].empty());
+    EXPECT_EQ(serializeLightTrees({&back[0], &back[1], &back[2]}), blob);
+}
+
+TEST(LightTreesIo, RejectsNoTreesOrTooManyWhenWriting) {
+    EXPECT_THROW(serializeLightTrees({}), std::invalid_argument);
+    const LightTree tree = smallTree();
+    const std::vector<const LightTree*> many(kMaxLightTreesInBlob + 1, &tree);
+    EXPECT_THROW(serializeLightTrees(many), std::invalid_argument);
+}
+
+TEST(LightTreesIo, RejectsASingleTreeBlobAndWrongVersion) {
+    const std::vector<uint8_t> single = serializeLightTree(smallTree());
+    expectTreesRejected(single, {"VRLTREES"});
+    std::vector<uint8_t> blob = threeTreesBlob();
+    putU32(blob, 8, kLightTreeFormatVersion + 1);
+    resealCrc(blob);
+    expectTreesRejected(blob, {"format version " + std::to_string(kLightTreeFormatVersion + 1)});
+}
+
+TEST(LightTreesIo, RejectsCountsOutOfRangeWithoutAllocating) {
+    for (uint32_t count : {0u, kMaxLightTreesInBlob + 1, 0xffffffffu}) {
+        std::vector<uint8_t> blob = threeTreesBlob();
+        putU32(blob, 12, count);
+        resealCrc(blob);
+        expectTreesRejected(blob, {"declares " + std::to_string(count) + " trees"});
+    }
+    std::vector<uint8_t> blob = threeTreesBlob();
+    putU32(blob, 12, 1000);  // in range, but its sizes would run past the blob
+    resealCrc(blob);
+    expectTreesRejected(blob, {"truncated"});
+}
+
+TEST(LightTreesIo, RejectsEveryTruncationAndTrailingBytes) {
+    const std::vector<uint8_t> blob = threeTreesBlob();
+    for (size_t n = 0; n < blob.size(); ++n) {
+        const std::vector<uint8_t> cut(blob.begin(), blob.begin() + n);
+        expectTreesRejected(cut, {}, "at " + std::to_string(n));
+    }
+    std::vector<uint8_t> longer = blob;
+    longer.push_back(0);
+    expectTreesRejected(longer, {"wrong size"});
+}
+
+TEST(LightTreesIo, RejectsTreeSizesThatDoNotAddUp) {
+    std::vector<uint8_t> blob = threeTreesBlob();
+    // First tree's size one byte more, second's one less: the total still fits, the trees do not.
+    const uint32_t first = uint32_t(blob[16]) | uint32_t(blob[17]) << 8 | uint32_t(blob[18]) << 16 | uint32_t(blob[19]) << 24;
+    const uint32_t second = uint32_t(blob[24]) | uint32_t(blob[25]) << 8 | uint32_t(blob[26]) << 16 | uint32_t(blob[27]) << 24;
+    putU32(blob, 16, first + 1);
+    putU32(blob, 24, second - 1);
+    resealCrc(blob);
+    expectTreesRejected(blob, {"light tree 0 of 3", "longer than expected"});
+    blob = threeTreesBlob();
+    putU32(blob, 20, 1);  // a size's high word: past the blob
+    resealCrc(blob);
+    expectTreesRejected(blob, {"exceeds the blob"});
+}
+
+TEST(LightTreesIo, RejectsEveryFlippedBit) {
+    const std::vector<uint8_t> blob = threeTreesBlob();
+    for (size_t byte = 0; byte < blob.size(); ++byte)
+        for (int bit = 0; bit < 8; ++bit) {
+            std::vector<uint8_t> bad = blob;
+            bad[byte] ^= uint8_t(1u << bit);
+            expectTreesRejected(bad, {}, "flipping byte " + std::to_string(byte) + " bit " + std::to_string(bit));
+        }
+}
+
 }  // namespace
 }  // namespace vrl
