@@ -10,6 +10,10 @@
 // With --build-only it traces and builds the tree only, handing the VRLs over to
 // the build as the renderer does, and prints the process's peak resident set so
 // far (the scale of the tree: 10^7 VRLs and more); -v logs the build's phases.
+// plain_ns and cut_ns: shading time per VRL estimate and core (wall time x TBB's
+// threads / estimates): plain VRLs make one estimate per VRL and shaded pixel
+// (one camera segment per pixel, as in the default scene: every ray ends on a
+// wall), the cut #Eval; the kernel's cost, with the cut's overhead in cut_ns.
 #include "render/core/timing.h"
 #include "render/image/image_metrics.h"
 #include "render/integrators/transport_integrator.h"
@@ -22,6 +26,7 @@
 #include <CLI/CLI.hpp>
 #include <spdlog/spdlog.h>
 #include <sys/resource.h>
+#include <tbb/info.h>
 #include <tbb/parallel_for.h>
 
 #include <atomic>
@@ -150,8 +155,10 @@ int main(int argc, char** argv) {
     }
     std::printf("scene %s%s, %dx%d, error threshold %.3f, part %s only\n", scenePath.c_str(), defined.c_str(), w, h,
                 error, surfacePart ? "(c) medium-to-surface" : "(d) medium-to-medium");
-    std::printf("%9s %8s %9s %8s %9s %10s %9s %9s %8s %9s %8s %8s %8s\n", "VRLs", "trace_s", "build_s", "tree_MB",
-                "global_s", "gatherX", "plain_s", "cuts_s", "speedup", "relRMSE", "#Eval", "#Inter", "cut");
+    std::printf("%9s %8s %9s %8s %9s %10s %9s %9s %8s %9s %8s %8s %8s %9s %8s\n", "VRLs", "trace_s", "build_s", "tree_MB",
+                "global_s", "gatherX", "plain_s", "cuts_s", "speedup", "relRMSE", "#Eval", "#Inter", "cut", "plain_ns",
+                "cut_ns");
+    const double cores = double(tbb::info::default_concurrency());
     for (uint64_t n : counts) {
         LightTracingSettings tracing;
         tracing.targetVrls = n;
@@ -175,11 +182,13 @@ int main(int argc, char** argv) {
             gather = std::to_string(double(cuts.total.evaluated) / std::max(1u, globalCuts.total.evaluated)).substr(0, 5);
         }
         const ImageErrorMetrics m = compareImages(plain.image, cuts.image);
-        std::printf("%9zu %8.3f %9.3f %8.1f %9s %10s %9.2f %9.2f %8.1f %9.5f %8.0f %8.0f %8.0f%s\n", vrls.vrls.size(),
-                    traceSeconds, buildSeconds, tree.memoryBytes() / 1e6, global.c_str(), gather.c_str(),
-                    plain.seconds, cuts.seconds, plain.seconds / cuts.seconds, m.relativeRmse,
-                    cuts.total.evaluated / pixels, cuts.total.intersected / pixels, cuts.total.cutSize / pixels,
-                    s > 1 ? "  (1/16 of the pixels)" : "");
+        const double plainNs = plain.seconds * cores * 1e9 / (pixels * double(vrls.vrls.size()));
+        const double cutNs = cuts.seconds * cores * 1e9 / std::max(1.0, double(cuts.total.evaluated));
+        std::printf("%9zu %8.3f %9.3f %8.1f %9s %10s %9.2f %9.2f %8.1f %9.5f %8.0f %8.0f %8.0f %9.0f %8.0f%s\n",
+                    vrls.vrls.size(), traceSeconds, buildSeconds, tree.memoryBytes() / 1e6, global.c_str(),
+                    gather.c_str(), plain.seconds, cuts.seconds, plain.seconds / cuts.seconds, m.relativeRmse,
+                    cuts.total.evaluated / pixels, cuts.total.intersected / pixels, cuts.total.cutSize / pixels, plainNs,
+                    cutNs, s > 1 ? "  (1/16 of the pixels)" : "");
         std::fflush(stdout);
     }
     std::printf("gatherX: #Eval of the hybrid tree over #Eval of the global agglomerative tree (paper: 1.25)\n");
