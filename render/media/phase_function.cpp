@@ -15,12 +15,6 @@ PhaseFunction PhaseFunction::henyeyGreenstein(float g) {
     return PhaseFunction(std::abs(g) < kIsotropicBelow ? 0.0f : g);
 }
 
-float PhaseFunction::evalCosine(float cosTheta) const {
-    if (g_ == 0.0f) return kInv4Pi;
-    const float denom = 1.0f + g_ * g_ - 2.0f * g_ * cosTheta;
-    return kInv4Pi * (1.0f - g_ * g_) / (denom * std::sqrt(denom));
-}
-
 float PhaseFunction::sampleCosine(float u) const {
     if (g_ == 0.0f) return 1.0f - 2.0f * u;
     // Inverse CDF of HG in the propagation convention (cos = 1 is forward), in

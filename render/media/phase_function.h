@@ -7,6 +7,8 @@
 
 #include "render/core/geometry.h"
 
+#include <cmath>
+
 namespace vrl {
 
 struct PhaseSample {
@@ -25,8 +27,13 @@ public:
     float g() const { return g_; }
     bool isIsotropic() const { return g_ == 0.0f; }
 
-    // Density for the cosine between propagation directions.
-    float evalCosine(float cosTheta) const;
+    // Density for the cosine between propagation directions. Inline: the VRL
+    // estimator calls it 18 times per estimate in an HG medium.
+    float evalCosine(float cosTheta) const {
+        if (g_ == 0.0f) return kInv4Pi;
+        const float denom = 1.0f + g_ * g_ - 2.0f * g_ * cosTheta;
+        return kInv4Pi * (1.0f - g_ * g_) / (denom * std::sqrt(denom));
+    }
     float eval(const Vec3& dirIn, const Vec3& dirOut) const { return evalCosine(dirIn.dot(dirOut)); }
     // Samples dirOut given dirIn from two uniform numbers in [0,1).
     PhaseSample sample(const Vec3& dirIn, const Vec2& u) const;

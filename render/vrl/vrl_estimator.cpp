@@ -37,12 +37,28 @@ LinePair linePair(const Vrl& vrl, const Vec3& lineOrigin, const Vec3& lineDirect
     return p;
 }
 
+// The asinh parametrisation of the VRL: A = asinh(a), B = asinh(b) with
+// a = s (0 - v0) / h, b = s (L - v0) / h, and the point v = v0 + h/s sinh(A + xi (B - A)).
+// Computed without asinh and sinh: with E(x) = e^asinh(x) = x + sqrt(x^2 + 1) (for
+// x < 0 as 1 / (sqrt(x^2 + 1) - x), free of cancellation), e^B / e^A - 1 =
+// (b - a) (1 + (a + b) / (sqrt(a^2 + 1) + sqrt(b^2 + 1))) / E(a) exactly, so
+// B - A = log1p of that (accurate also when a and b are close), and
+// sinh(A + xi (B - A)) = (X - 1/X) / 2 with X = E(a) e^(xi (B - A)): one log1p and
+// one exp where asinh, asinh, sinh took three logarithm-class calls and an exp.
 struct AsinhRange {
-    double a0, a1, h;
+    double span, expA, h;  // B - A, e^A, h floored
+    // sinh(A + xi (B - A)).
+    double sinhAt(double xi) const {
+        const double x = expA * std::exp(xi * span);
+        return 0.5 * (x - 1.0 / x);
+    }
 };
 AsinhRange asinhRange(const LinePair& p, double length) {
     const double h = std::max(p.h0, p.epsilon);
-    return {std::asinh(p.sinTheta * (0.0 - p.v0) / h), std::asinh(p.sinTheta * (length - p.v0) / h), h};
+    const double a = p.sinTheta * (0.0 - p.v0) / h, b = p.sinTheta * (length - p.v0) / h;
+    const double ra = std::sqrt(a * a + 1.0), rb = std::sqrt(b * b + 1.0);
+    const double expA = a >= 0.0 ? a + ra : 1.0 / (ra - a);
+    return {std::log1p((b - a) * (1.0 + (a + b) / (ra + rb)) / expA), expA, h};
 }
 
 struct Equiangular {
@@ -58,6 +74,31 @@ Equiangular equiangular(const Vec3& origin, const Vec3& direction, float length,
     return {delta, h, std::atan2(0.0 - delta, h), std::atan2(double(length) - delta, h)};
 }
 
+// Equiangular sampling of the camera segment from xv in the angle phi measured
+// from the segment's start, phi in [0, span): u - delta = h tan(thetaA + phi).
+// With t_a = tan(thetaA) = -delta / h, the span thetaB - thetaA is one atan2,
+// atan2(L h, h^2 - delta (L - delta)) (the tangent difference formula; its sine
+// part L h > 0 puts it in (0, pi) as the span is), and
+// tan(thetaA + phi) = (t_a + tan phi) / (1 - t_a tan phi), so neither angle is formed:
+// one atan2 and one tan per estimate where two atan2 and a tan were.
+struct EquiangularSpan {
+    double delta, h, span;
+    double cosA, sinA;  // of thetaA, for the anisotropic bins
+    double offsetAt(double phi) const {  // u - delta
+        const double t = std::tan(phi);
+        return h * (h * t - delta) / (h + delta * t);
+    }
+};
+EquiangularSpan equiangularSpan(const Vec3& origin, const Vec3& direction, float length, const Vec3& point) {
+    const V3d w = toDouble(direction), r = toDouble(point - origin);
+    const double delta = w.dot(r);
+    const double distance = (r - w * delta).length();
+    const double h = std::max(distance, 1e-7 * (1.0 + r.length()));  // as equiangular()
+    const double L = double(length);
+    const double radius = std::sqrt(h * h + delta * delta);
+    return {delta, h, std::atan2(L * h, h * h - delta * (L - delta)), h / radius, -delta / radius};
+}
+
 }  // namespace
 
 DistanceSample sampleVrlPoint(const Vrl& vrl, const Vec3& lineOrigin, const Vec3& lineDirection, float xi) {
@@ -65,11 +106,10 @@ DistanceSample sampleVrlPoint(const Vrl& vrl, const Vec3& lineOrigin, const Vec3
     const LinePair p = linePair(vrl, lineOrigin, lineDirection);
     if (p.parallel) return {xi * vrl.length, 1.0f / vrl.length};
     const AsinhRange a = asinhRange(p, vrl.length);
-    if (!(a.a1 > a.a0)) return {xi * vrl.length, 1.0f / vrl.length};
+    if (!(a.span > 0.0) || !std::isfinite(a.span)) return {xi * vrl.length, 1.0f / vrl.length};
     // Round to the float returned first, so the pdf is that of the point returned.
-    const double v = double(std::clamp(float(p.v0 + a.h / p.sinTheta * std::sinh(a.a0 + xi * (a.a1 - a.a0))), 0.0f,
-                                       vrl.length));
-    const double pdf = p.sinTheta / ((a.a1 - a.a0) * std::sqrt(a.h * a.h + p.sinTheta * p.sinTheta * (v - p.v0) * (v - p.v0)));
+    const double v = double(std::clamp(float(p.v0 + a.h / p.sinTheta * a.sinhAt(xi)), 0.0f, vrl.length));
+    const double pdf = p.sinTheta / (a.span * std::sqrt(a.h * a.h + p.sinTheta * p.sinTheta * (v - p.v0) * (v - p.v0)));
     return {float(v), float(pdf)};
 }
 
@@ -78,8 +118,8 @@ float vrlPointPdf(const Vrl& vrl, const Vec3& lineOrigin, const Vec3& lineDirect
     const LinePair p = linePair(vrl, lineOrigin, lineDirection);
     if (p.parallel) return 1.0f / vrl.length;
     const AsinhRange a = asinhRange(p, vrl.length);
-    if (!(a.a1 > a.a0)) return 1.0f / vrl.length;
-    return float(p.sinTheta / ((a.a1 - a.a0) * std::sqrt(a.h * a.h + p.sinTheta * p.sinTheta * (v - p.v0) * (v - p.v0))));
+    if (!(a.span > 0.0) || !std::isfinite(a.span)) return 1.0f / vrl.length;
+    return float(p.sinTheta / (a.span * std::sqrt(a.h * a.h + p.sinTheta * p.sinTheta * (v - p.v0) * (v - p.v0))));
 }
 
 DistanceSample sampleEquiangular(const Vec3& origin, const Vec3& direction, float length, const Vec3& point,
@@ -119,15 +159,14 @@ Rgb VrlEstimator::sampleOnce(const Vrl& vrl, const CameraSegment& segment, Rng& 
 
     // u | v: equiangular from xv, or for anisotropic media a mixture of that with a
     // piecewise-constant fit of f(u) f(v) over kBins bins of the equiangular angle.
-    const Equiangular e = equiangular(segment.origin, segment.direction, segment.length, xv);
-    const double span = e.thetaB - e.thetaA;
+    const EquiangularSpan e = equiangularSpan(segment.origin, segment.direction, segment.length, xv);
+    const double span = e.span;
     if (!(span > 0.0)) return Rgb(0.0f);
     const bool anisotropic = !mediumU.phase().isIsotropic() || !mediumV.phase().isIsotropic();
     constexpr int kBins = 8;
     constexpr double kUniformWeight = 0.25;
     std::array<double, kBins> binWeight{};
     double binTotal = 0.0;
-    double theta;
     if (anisotropic) {
         // In the plane of the camera line and xv, the direction from xv to u(theta) is
         // w sin(theta) - e cos(theta), e the unit offset of xv from the line: so
@@ -138,8 +177,10 @@ Rgb VrlEstimator::sampleOnce(const Vrl& vrl, const CameraSegment& segment, Rng& 
         const Vec3 unitOffset = offsetLength > 0.0f ? offset / offsetLength : Frame::fromNormal(segment.direction).s;
         const double dw = vrl.direction.dot(segment.direction), de = vrl.direction.dot(unitOffset);
         const double step = span / kBins;
-        double c = std::cos(e.thetaA + 0.5 * step), s = std::sin(e.thetaA + 0.5 * step);
-        const double cStep = std::cos(step), sStep = std::sin(step);
+        // cos, sin of thetaA + step / 2, then rotated by step per bin (one sincos pair).
+        const double cHalf = std::cos(0.5 * step), sHalf = std::sin(0.5 * step);
+        const double cStep = cHalf * cHalf - sHalf * sHalf, sStep = 2.0 * sHalf * cHalf;
+        double c = e.cosA * cHalf - e.sinA * sHalf, s = e.sinA * cHalf + e.cosA * sHalf;
         for (int b = 0; b < kBins; ++b) {
             binWeight[b] = double(mediumV.phase().evalCosine(float(s * dw - c * de)) * mediumU.phase().evalCosine(float(-s)));
             binTotal += binWeight[b];
@@ -148,21 +189,22 @@ Rgb VrlEstimator::sampleOnce(const Vrl& vrl, const CameraSegment& segment, Rng& 
             c = cNext;
         }
     }
+    double phi;  // the angle from thetaA
     if (anisotropic && binTotal > 0.0 && rng.next() >= kUniformWeight) {
         double target = rng.next() * binTotal;
         int b = 0;
         while (b < kBins - 1 && target >= binWeight[b]) target -= binWeight[b++];
-        theta = e.thetaA + (b + rng.next()) * span / kBins;
+        phi = (b + rng.next()) * span / kBins;
     } else {
-        theta = e.thetaA + rng.next() * span;
+        phi = rng.next() * span;
     }
-    theta = std::clamp(theta, e.thetaA, e.thetaB);
+    phi = std::clamp(phi, 0.0, span);
     double thetaPdf = 1.0 / span;  // density in the angle
     if (anisotropic && binTotal > 0.0) {
-        const int b = std::min(kBins - 1, int((theta - e.thetaA) / span * kBins));
+        const int b = std::min(kBins - 1, int(phi / span * kBins));
         thetaPdf = kUniformWeight / span + (1.0 - kUniformWeight) * binWeight[b] / binTotal * kBins / span;
     }
-    const double u = double(std::clamp(float(e.delta + e.h * std::tan(theta)), 0.0f, segment.length));
+    const double u = double(std::clamp(float(e.delta + e.offsetAt(phi)), 0.0f, segment.length));
     const double uPdf = thetaPdf * e.h / (e.h * e.h + (u - e.delta) * (u - e.delta));
 
     const Vec3 xu = segment.origin + segment.direction * float(u);
@@ -172,13 +214,13 @@ Rgb VrlEstimator::sampleOnce(const Vrl& vrl, const CameraSegment& segment, Rng& 
     const float w = std::sqrt(w2);
     const Vec3 toU = d / w;
     const float phase = mediumV.phase().eval(vrl.direction, toU) * mediumU.phase().eval(toU, -segment.direction);
-    const Rgb cameraTransmittance = segment.throughputBefore * mediumU.transmittance(float(u));
-    const Rgb between = vrl.medium == segment.medium && !scene_.mediumNeedsVisibility(segment.medium)
-                            ? mediumU.transmittance(w)
-                            : scene_.transmittance(xu, xv, segment.medium);
-    if (isBlack(between)) return Rgb(0.0f);
+    // In one medium with nothing to occlude, T(u) T(w) = T(u + w): one exponential.
+    const Rgb transmittance = vrl.medium == segment.medium && !scene_.mediumNeedsVisibility(segment.medium)
+                                  ? mediumU.transmittance(float(u) + w)
+                                  : mediumU.transmittance(float(u)) * scene_.transmittance(xu, xv, segment.medium);
+    if (isBlack(transmittance)) return Rgb(0.0f);
     const double scale = double(phase) / (double(w2) * double(vs.pdf) * uPdf);
-    return vrl.flux * mediumV.sigmaS() * mediumU.sigmaS() * cameraTransmittance * between * float(scale);
+    return vrl.flux * mediumV.sigmaS() * mediumU.sigmaS() * segment.throughputBefore * transmittance * float(scale);
 }
 
 }  // namespace vrl
