@@ -40,8 +40,11 @@ LinePair linePair(const Vrl& vrl, const Vec3& lineOrigin, const Vec3& lineDirect
 // The asinh parametrisation of the VRL: A = asinh(a), B = asinh(b) with
 // a = s (0 - v0) / h, b = s (L - v0) / h, and the point v = v0 + h/s sinh(A + xi (B - A)).
 // Computed without asinh and sinh: with E(x) = e^asinh(x) = x + sqrt(x^2 + 1) (for
-// x < 0 as 1 / (sqrt(x^2 + 1) - x), free of cancellation), e^B / e^A - 1 =
-// (b - a) (1 + (a + b) / (sqrt(a^2 + 1) + sqrt(b^2 + 1))) / E(a) exactly, so
+// x < 0 as 1 / (sqrt(x^2 + 1) - x), free of cancellation), and r_x = sqrt(x^2 + 1),
+//   e^B / e^A - 1 = (b - a) (1 + (a + b) / (r_a + r_b)) / E(a)        (a + b >= 0)
+//                 = (b - a) (1 - (a + b) / (r_a + r_b)) / (r_b - b)  (a + b < 0)
+// exactly (the one whose bracket lies in [1, 2]: no cancellation, also for the
+// large |a|, |b| of a VRL almost parallel to the camera line), so
 // B - A = log1p of that (accurate also when a and b are close), and
 // sinh(A + xi (B - A)) = (X - 1/X) / 2 with X = E(a) e^(xi (B - A)): one log1p and
 // one exp where asinh, asinh, sinh took three logarithm-class calls and an exp.
@@ -58,7 +61,9 @@ AsinhRange asinhRange(const LinePair& p, double length) {
     const double a = p.sinTheta * (0.0 - p.v0) / h, b = p.sinTheta * (length - p.v0) / h;
     const double ra = std::sqrt(a * a + 1.0), rb = std::sqrt(b * b + 1.0);
     const double expA = a >= 0.0 ? a + ra : 1.0 / (ra - a);
-    return {std::log1p((b - a) * (1.0 + (a + b) / (ra + rb)) / expA), expA, h};
+    const double sum = (a + b) / (ra + rb);
+    const double ratioMinusOne = a + b >= 0.0 ? (b - a) * (1.0 + sum) / expA : (b - a) * (1.0 - sum) / (rb - b);
+    return {std::log1p(ratioMinusOne), expA, h};
 }
 
 struct Equiangular {
