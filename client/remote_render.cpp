@@ -97,6 +97,12 @@ public:
 
     void show(const v1::JobProgress& p) {
         if (quiet_) return;
+        // Phases that ended since the last update, each as a finished bar (one may have begun and
+        // ended between two polls).
+        for (; shownDone_ < p.preparing_phases_done_size(); ++shownDone_) {
+            begin(p.preparing_phases_done(shownDone_));
+            end(true);
+        }
         if (p.state() == v1::JOB_STATE_PREPARING) {
             begin(p.preparing_phase().empty() ? "loading the scene" : p.preparing_phase());
             bar_->update(std::clamp(p.preparing_fraction(), 0.0, 1.0));
@@ -147,6 +153,7 @@ private:
     bool quiet_;
     std::unique_ptr<ProgressBar> bar_;
     std::string label_;
+    int shownDone_ = 0;  // entries of preparing_phases_done shown
 };
 
 // Once: "no worker has connected ..." when the coordinator has had no worker for `after` while the job waits.

@@ -218,6 +218,8 @@ void Coordinator::prepare(Job& job) {
         const PreparedJob prepared = preparation_.prepare(job, [&](const char* phase, double f) {
             std::lock_guard lock(mutex_);
             if (job.preparingPhase != phase || std::abs(f - job.preparingFraction) >= 0.01 || f >= 1.0) {
+                if (job.preparingPhase != phase && !job.preparingPhase.empty())
+                    job.preparingPhasesDone.push_back(job.preparingPhase);
                 job.preparingPhase = phase;
                 job.preparingFraction = f;
                 touch(job);
@@ -226,6 +228,7 @@ void Coordinator::prepare(Job& job) {
 
         std::lock_guard lock(mutex_);
         if (job.state != v1::JOB_STATE_PREPARING) return;  // cancelled meanwhile
+        if (!job.preparingPhase.empty()) job.preparingPhasesDone.push_back(job.preparingPhase);
         preparation_.install(job, prepared);
         store_.publishAsset(job.spec.bundle_sha256(), prepared.bundle);
         if (prepared.lights) store_.publishAsset(prepared.lightsSha, prepared.lights);

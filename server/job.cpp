@@ -31,6 +31,7 @@ v1::JobProgress progressOf(const Job& job) {
     p.set_time_limit_seconds(job.settings.timeLimitSeconds);
     p.set_preparing_fraction(job.preparingFraction);
     p.set_preparing_phase(job.preparingPhase);
+    for (const std::string& phase : job.preparingPhasesDone) p.add_preparing_phases_done(phase);
     p.set_submitted_unix_ms(job.submittedUnixMs);
     p.set_finished_unix_ms(job.finishedUnixMs);
     double eta = -1.0;

@@ -42,6 +42,7 @@ struct Job {
     uint64_t version = 0;  // bumped on every change that waitForChange reports
     double preparingFraction = 0.0;  // of preparingPhase
     std::string preparingPhase;
+    std::vector<std::string> preparingPhasesDone;  // in order; the last one once the job is prepared
     int64_t submittedUnixMs = 0;  // wall clock, persisted in record.pb
     int64_t finishedUnixMs = 0;   // 0 while unfinished
     std::vector<std::pair<std::string, double>> phases;

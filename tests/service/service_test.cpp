@@ -172,7 +172,14 @@ TEST(Service, LightcutsImageAndLayersAreBitIdenticalToTheEmbeddedRender) {
     cluster.startWorker("b");
     cluster.startWorker("c");
     const v1::JobSpec spec = makeSpec("vrl-lightcuts", 1, 3, 32, 24, 8);
-    expectBitIdentical(embeddedRender(spec), cluster.waitForImage(cluster.submit(spec)));
+    const std::string id = cluster.submit(spec);
+    expectBitIdentical(embeddedRender(spec), cluster.waitForImage(id));
+    // Every preparation phase is listed once over, in order, however short it was: a client
+    // whose polls fell between them still shows each (client/remote_render.cpp).
+    const v1::JobProgress progress = cluster.coordinator().jobProgress(id);
+    ASSERT_EQ(progress.preparing_phases_done_size(), 2) << progress.ShortDebugString();
+    EXPECT_EQ(progress.preparing_phases_done(0), "light tracing");
+    EXPECT_EQ(progress.preparing_phases_done(1), "building the light tree");
 }
 
 TEST(Service, PlainVrlImageIsBitIdenticalToTheEmbeddedRender) {
