@@ -3,12 +3,12 @@
 // window equals that window of the full film.
 #include "render/render_metadata.h"
 #include "render/renderer.h"
+#include "tests/support/image_compare.h"
 #include "tests/support/test_scenes.h"
 
 #include <gtest/gtest.h>
 #include <tbb/task_arena.h>
 
-#include <cstring>
 #include <optional>
 
 namespace vrl {
@@ -21,10 +21,7 @@ Image renderWithThreads(const Scene& scene, const RenderSettings& settings, int 
     return image;
 }
 
-bool bitIdentical(const Image& a, const Image& b) {
-    return a.width() == b.width() && a.height() == b.height() &&
-           std::memcmp(a.pixels().data(), b.pixels().data(), a.pixelCount() * sizeof(Rgb)) == 0;
-}
+using test::bitIdentical;
 
 TEST(RendererDeterminism, SameSeedSameImageWithOneAndTwoThreads) {
     const auto scene = Scene::build(test::smallSmokeRoom());

@@ -8,29 +8,18 @@
 // this argument needs (distinct sets, the sample-to-set rule, determinism).
 #include "render/lightcuts/light_tree_io.h"
 #include "render/renderer.h"
+#include "tests/support/image_compare.h"
 #include "tests/support/test_scenes.h"
 
 #include <gtest/gtest.h>
 #include <tbb/task_arena.h>
 
-#include <cstring>
 
 namespace vrl {
 namespace {
 
-bool bitIdentical(const Image& a, const Image& b) {
-    return a.width() == b.width() && a.height() == b.height() &&
-           std::memcmp(a.pixels().data(), b.pixels().data(), a.pixelCount() * sizeof(Rgb)) == 0;
-}
-
-::testing::AssertionResult sameLayers(const ImageSet& a, const ImageSet& b) {
-    if (!bitIdentical(a.image, b.image)) return ::testing::AssertionFailure() << "the image differs";
-    if (a.layers.size() != b.layers.size()) return ::testing::AssertionFailure() << "layer counts differ";
-    for (size_t l = 0; l < a.layers.size(); ++l)
-        if (a.layers[l].first != b.layers[l].first || !bitIdentical(a.layers[l].second, b.layers[l].second))
-            return ::testing::AssertionFailure() << "layer " << a.layers[l].first << " differs";
-    return ::testing::AssertionSuccess();
-}
+using test::bitIdentical;
+using test::sameLayers;
 
 RenderSettings stochasticSettings(int sets, int spp) {
     RenderSettings settings;
