@@ -88,7 +88,6 @@ Equiangular equiangular(const Vec3& origin, const Vec3& direction, float length,
 // one atan2 and one tan per estimate where two atan2 and a tan were.
 struct EquiangularSpan {
     double delta, h, span;
-    double cosA, sinA;  // of thetaA, for the anisotropic bins
     double offsetAt(double phi) const {  // u - delta
         const double t = std::tan(phi);
         return h * (h * t - delta) / (h + delta * t);
@@ -100,8 +99,7 @@ EquiangularSpan equiangularSpan(const Vec3& origin, const Vec3& direction, float
     const double distance = (r - w * delta).length();
     const double h = std::max(distance, 1e-7 * (1.0 + r.length()));  // as equiangular()
     const double L = double(length);
-    const double radius = std::sqrt(h * h + delta * delta);
-    return {delta, h, std::atan2(L * h, h * h - delta * (L - delta)), h / radius, -delta / radius};
+    return {delta, h, std::atan2(L * h, h * h - delta * (L - delta))};
 }
 
 }  // namespace
@@ -182,10 +180,13 @@ Rgb VrlEstimator::sampleOnce(const Vrl& vrl, const CameraSegment& segment, Rng& 
         const Vec3 unitOffset = offsetLength > 0.0f ? offset / offsetLength : Frame::fromNormal(segment.direction).s;
         const double dw = vrl.direction.dot(segment.direction), de = vrl.direction.dot(unitOffset);
         const double step = span / kBins;
-        // cos, sin of thetaA + step / 2, then rotated by step per bin (one sincos pair).
+        // cos, sin of thetaA + step / 2 (cos thetaA = h / r, sin thetaA = -delta / r), then
+        // rotated by step per bin (one sincos pair); only here, not for isotropic media.
+        const double radius = std::sqrt(e.h * e.h + e.delta * e.delta);
+        const double cosA = e.h / radius, sinA = -e.delta / radius;
         const double cHalf = std::cos(0.5 * step), sHalf = std::sin(0.5 * step);
         const double cStep = cHalf * cHalf - sHalf * sHalf, sStep = 2.0 * sHalf * cHalf;
-        double c = e.cosA * cHalf - e.sinA * sHalf, s = e.sinA * cHalf + e.cosA * sHalf;
+        double c = cosA * cHalf - sinA * sHalf, s = sinA * cHalf + cosA * sHalf;
         for (int b = 0; b < kBins; ++b) {
             binWeight[b] = double(mediumV.phase().evalCosine(float(s * dw - c * de)) * mediumU.phase().evalCosine(float(-s)));
             binTotal += binWeight[b];
