@@ -14,6 +14,14 @@
 // threads / estimates): plain VRLs make one estimate per VRL and shaded pixel
 // (one camera segment per pixel, as in the default scene: every ray ends on a
 // wall), the cut #Eval; the kernel's cost, with the cut's overhead in cut_ns.
+// With --hg-compare (scenes with Henyey-Greenstein media) it compares the two HG
+// bounds of VRL cuts (cluster_bound.h), the proven cone bound and the paper's
+// (1 + --hg-epsilon) heuristic, over the error thresholds of --errors: per
+// threshold and bound, the cut's time, its relative RMSE against plain VRLs of
+// the same set and streams, #Eval, cut size and the share of cluster estimates
+// above their bound; then, at each heuristic point, the cone bound's time at
+// the same relative RMSE (log-log interpolation between its bracketing points)
+// over the heuristic's time: the "slower at equal error" ratio.
 #include "render/core/timing.h"
 #include "render/image/image_metrics.h"
 #include "render/integrators/transport_integrator.h"
@@ -31,7 +39,9 @@
 
 #include <atomic>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
+#include <vector>
 
 using namespace vrl;
 
@@ -41,19 +51,21 @@ struct Shading {
     Image image;
     double seconds = 0.0;
     CutStatistics total;
+    uint64_t boundExceeded = 0, boundedEstimates = 0;
 };
 
 // Part (d) or (c) on every `stride`-th pixel in x and y (the others stay black).
 Shading shade(const Scene& scene, const VrlSet& vrls, const LightTree* tree, float error, int stride, uint64_t seed,
-              bool surfacePart) {
+              bool surfacePart, const ClusterBoundSettings& bound = {}) {
     TransportIntegratorSettings settings;
     settings.transports = TransportSelection::parse(surfacePart ? "medium-surface" : "multiple");
     settings.cut.errorThreshold = error;
+    settings.cut.bound = bound;
     const TransportIntegrator integrator(scene, vrls, settings, tree);
     const PerspectiveCamera& camera = scene.camera();
     Shading out;
     out.image = Image(camera.width(), camera.height());
-    std::atomic<uint64_t> evaluated{0}, intersected{0}, cutSize{0};
+    std::atomic<uint64_t> evaluated{0}, intersected{0}, cutSize{0}, exceeded{0}, bounded{0};
     const auto start = std::chrono::steady_clock::now();
     tbb::parallel_for(0, (camera.height() + stride - 1) / stride, [&](int row) {
         const int y = row * stride;
@@ -63,11 +75,65 @@ Shading shade(const Scene& scene, const VrlSet& vrls, const LightTree* tree, flo
             const auto parts = integrator.virtualLightParts(camera.generateRay(x + 0.5f, y + 0.5f), rng, &stats, &stats);
             out.image.at(x, y) = surfacePart ? parts.mediumSurface : parts.multiple;
             evaluated += stats.evaluated, intersected += stats.intersected, cutSize += stats.cutSize;
+            exceeded += stats.boundExceeded, bounded += stats.boundedEstimates;
         }
     });
     out.seconds = secondsSince(start);
     out.total = {uint32_t(evaluated.load()), uint32_t(intersected.load()), uint32_t(cutSize.load())};
+    out.boundExceeded = exceeded.load(), out.boundedEstimates = bounded.load();
     return out;
+}
+
+struct HgPoint {
+    float error;
+    double seconds, relativeRmse, evaluated, cutSize, exceededShare;
+};
+
+// Time at relative RMSE `target` on the curve `points` (log-log interpolation between
+// the two points that bracket it); negative when no two points do.
+double secondsAtError(const std::vector<HgPoint>& points, double target) {
+    for (size_t i = 0; i < points.size(); ++i)
+        for (size_t j = 0; j < points.size(); ++j) {
+            const HgPoint &a = points[i], &b = points[j];
+            if (!(a.relativeRmse <= target && target <= b.relativeRmse) || a.relativeRmse == b.relativeRmse) continue;
+            const double t = std::log(target / a.relativeRmse) / std::log(b.relativeRmse / a.relativeRmse);
+            return std::exp(std::log(a.seconds) + t * (std::log(b.seconds) - std::log(a.seconds)));
+        }
+    return -1.0;
+}
+
+// --hg-compare: the two HG bounds over the error thresholds, against plain VRLs.
+void compareHgBounds(const Scene& scene, const VrlSet& vrls, const LightTree& tree, const std::vector<float>& errors,
+                     float epsilon, int stride, double pixels, bool surfacePart) {
+    const Shading plain = shade(scene, vrls, nullptr, 0.0f, stride, 1, surfacePart);
+    std::printf("  plain VRLs: %.2f s\n", plain.seconds);
+    std::printf("  %-8s %8s %8s %9s %8s %8s %10s\n", "bound", "error", "cuts_s", "relRMSE", "#Eval", "cut",
+                "exceeded%");
+    std::vector<HgPoint> curves[2];
+    for (float error : errors) {
+        for (int b = 0; b < 2; ++b) {
+            ClusterBoundSettings bound;
+            bound.hgBound = b == 0 ? HgBound::Cones : HgBound::Epsilon;
+            bound.anisotropyEpsilon = epsilon;
+            const Shading cut = shade(scene, vrls, &tree, error, stride, 1, surfacePart, bound);
+            const HgPoint p{error, cut.seconds, compareImages(plain.image, cut.image).relativeRmse,
+                            cut.total.evaluated / pixels, cut.total.cutSize / pixels,
+                            100.0 * double(cut.boundExceeded) / double(std::max<uint64_t>(1, cut.boundedEstimates))};
+            curves[b].push_back(p);
+            std::printf("  %-8s %8.3f %8.2f %9.5f %8.0f %8.0f %10.4f\n", b == 0 ? "cones" : "epsilon", error, p.seconds,
+                        p.relativeRmse, p.evaluated, p.cutSize, p.exceededShare);
+            std::fflush(stdout);
+        }
+    }
+    for (const HgPoint& e : curves[1]) {
+        const double cones = secondsAtError(curves[0], e.relativeRmse);
+        if (cones > 0.0)
+            std::printf("  at relRMSE %.5f (epsilon, error %.3f: %.2f s) the cone bound takes %.2f s: %.2fx\n",
+                        e.relativeRmse, e.error, e.seconds, cones, cones / e.seconds);
+        else
+            std::printf("  at relRMSE %.5f (epsilon, error %.3f) the cone bound's curve does not reach: no ratio\n",
+                        e.relativeRmse, e.error);
+    }
 }
 
 // Peak resident set of this process so far, in MB.
@@ -111,7 +177,9 @@ int main(int argc, char** argv) {
     uint64_t strideAbove = 200000;
     int stride = 4;
     std::vector<std::string> defines;
-    bool buildOnlyMode = false, verbose = false;
+    bool buildOnlyMode = false, verbose = false, hgCompare = false;
+    std::vector<float> errors = {0.005f, 0.01f, 0.02f, 0.05f, 0.1f, 0.2f, 0.5f, 1.0f, 2.0f};
+    float hgEpsilon = 1.0f;
     app.add_option("--scene", scenePath, "Scene file (default scenes/smoke-room.xml)");
     app.add_option("-D,--define", defines, "Override a scene <default>: -D name=value (repeatable)");
     app.add_option("--vrls", counts, "VRL counts to run (default 10000 100000 1000000)");
@@ -123,6 +191,10 @@ int main(int argc, char** argv) {
     app.add_option("--part", part, "Transport part: multiple (d, default) or medium-surface (c)")
         ->check(CLI::IsMember({"multiple", "medium-surface"}));
     app.add_flag("--build-only", buildOnlyMode, "Trace and build the light tree only: build time, tree size, peak memory");
+    app.add_flag("--hg-compare", hgCompare,
+                 "Compare the proven HG cone bound with the (1 + --hg-epsilon) heuristic over --errors");
+    app.add_option("--errors", errors, "--hg-compare: error thresholds (default 0.005 ... 2: the cone bound needs larger ones for the same error)");
+    app.add_option("--hg-epsilon", hgEpsilon, "--hg-compare: the heuristic's epsilon (default 1)");
     app.add_flag("-v,--verbose", verbose, "Log the light tree build's phases (spdlog debug)");
     CLI11_PARSE(app, argc, argv);
     const bool surfacePart = part == "medium-surface";
@@ -151,6 +223,22 @@ int main(int argc, char** argv) {
     if (buildOnlyMode) {
         std::printf("scene %s%s, light tree build only\n", scenePath.c_str(), defined.c_str());
         buildOnly(*scene, description.integrator.maxDepth, counts);
+        return 0;
+    }
+    if (hgCompare) {
+        std::printf("scene %s%s, %dx%d, part %s only: HG bounds, cones against epsilon = %g\n", scenePath.c_str(),
+                    defined.c_str(), w, h, surfacePart ? "(c) medium-to-surface" : "(d) medium-to-medium", hgEpsilon);
+        for (uint64_t n : counts) {
+            LightTracingSettings tracing;
+            tracing.targetVrls = n;
+            tracing.maxDepth = description.integrator.maxDepth;
+            const VrlSet vrls = traceVrls(*scene, tracing);
+            const LightTree tree = LightTree::build(vrls.vrls);
+            const int s = n > strideAbove ? stride : 1;
+            std::printf("%zu VRLs%s\n", vrls.vrls.size(), s > 1 ? " (1/16 of the pixels)" : "");
+            compareHgBounds(*scene, vrls, tree, errors, hgEpsilon, s, double((w + s - 1) / s) * ((h + s - 1) / s),
+                            surfacePart);
+        }
         return 0;
     }
     std::printf("scene %s%s, %dx%d, error threshold %.3f, part %s only\n", scenePath.c_str(), defined.c_str(), w, h,

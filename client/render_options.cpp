@@ -106,8 +106,9 @@ void addRenderOptions(CLI::App& cmd, RenderCommandOptions& o) {
                     "their VRLs rather than their box (default 32)")
         ->check(CLI::Range(0u, 1u << 20));
     cmd.add_option("--hg-epsilon", o.hgEpsilon,
-                    "vrl-lightcuts, vpl-lightcuts: Henyey-Greenstein media multiply the isotropic bound by (1 + this) "
-                   "(default 1)")
+                   "vrl-lightcuts: bound Henyey-Greenstein media by the paper's heuristic, the isotropic bound x "
+                   "(1 + this), instead of the proven bound over cones of directions (the default); vpl-lightcuts: "
+                   "always this heuristic (default 1)")
         ->check(CLI::Range(0.0f, 1e6f));
     cmd.add_option("--partition-size", o.partitionSize,
                     "vrl-lightcuts, vpl-lightcuts: lights per partition before agglomerative clustering (default 2048)")
@@ -229,7 +230,8 @@ v1::RenderParameters toRenderParameters(const RenderCommandOptions& o) {
     p.set_error(o.error);
     p.set_max_cut(o.maxCut);
     p.set_exact_distance_below(o.exactDistanceBelow);
-    p.set_hg_epsilon(o.hgEpsilon);
+    p.set_hg_epsilon(o.hgEpsilon.value_or(ClusterBoundSettings{}.anisotropyEpsilon));
+    p.set_hg_epsilon_bound(o.hgEpsilon.has_value());
     p.set_partition_size(o.partitionSize);
     p.set_cut_size(o.cutSize);
     p.set_vrl_sets(o.vrlSets);

@@ -10,6 +10,7 @@
 
 #include <cstdint>
 #include <map>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -38,7 +39,7 @@ struct RenderCommandOptions {
     float error = 0.02f;
     uint32_t maxCut = 4096;
     uint32_t exactDistanceBelow = 32;
-    float hgEpsilon = 1.0f;
+    std::optional<float> hgEpsilon;  // given: vrl-lightcuts use the (1 + epsilon) heuristic in HG media; default 1
     uint32_t partitionSize = 2048;
     uint32_t cutSize = 32;  // vrl-stochastic
     uint32_t vrlSets = 1;   // vrl-stochastic

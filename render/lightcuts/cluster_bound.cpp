@@ -2,6 +2,9 @@
 
 #include "render/core/distance.h"
 #include "render/scene/scene.h"
+#include "render/vrl/vrl_estimator.h"
+
+#include <Imath/ImathVec.h>
 
 #include <algorithm>
 #include <cmath>
@@ -13,13 +16,138 @@ namespace {
 // Float noise in the estimator's own arithmetic (rounded sample points): the bound
 // carries this relative margin.
 constexpr double kRoundingMargin = 1.001;
+constexpr double kPiD = 3.14159265358979323846;
+constexpr double kInv4PiD = 1.0 / (4.0 * kPiD);
+// HG's float denominator 1 + g^2 - 2 g cos is off by a few 1e-7 at most.
+constexpr double kHgDenominatorSlack = 2e-6;
+
+using V3d = Imath::V3d;
+V3d toD(const Vec3& v) { return {v.x, v.y, v.z}; }
+double angleD(const V3d& a, const V3d& b) { return std::atan2(a.cross(b).length(), a.dot(b)); }
+
+struct PhaseRange {
+    double low, high;
+};
+
+// Bounds of one HG phase function (float g, as evaluated in float by
+// PhaseFunction::evalCosine) over scattering cosines in [cosLow, cosHigh].
+PhaseRange hgRange(float g, double cosLow, double cosHigh) {
+    if (g == 0.0f) return {double(kInv4Pi), double(kInv4Pi)};  // evalCosine's value
+    const double gd = g;
+    const double numerator = kInv4PiD * (1.0 - gd * gd);
+    // Increasing in the cosine for g > 0: the largest value at the largest cosine.
+    const double cosNear = g > 0.0f ? cosHigh : cosLow, cosFar = g > 0.0f ? cosLow : cosHigh;
+    const double near = 1.0 + gd * gd - 2.0 * gd * cosNear - kHgDenominatorSlack;
+    const double far = 1.0 + gd * gd - 2.0 * gd * cosFar + kHgDenominatorSlack;
+    const double high = near > 0.0 ? numerator / (near * std::sqrt(near)) * (1.0 + 1e-5) : kInfinity;
+    return {numerator / (far * std::sqrt(far)) * (1.0 - 1e-5), high};
+}
+
+struct AngleRange {
+    double low, high;  // in [0, pi]
+};
+
+// The cosines of the polar angles, from the camera direction omega, of the
+// directions u - v (u on the segment, v in the box, at least h from the camera
+// line): with s the offset along omega from v's foot point to u and r v's
+// distance to the line, cos = s / sqrt(s^2 + r^2), monotone in s and (by s's
+// sign) in r; s ranges over
+// [-max (v - o).omega, S - min (v - o).omega], r over [h, farthest point of the
+// box's bounding sphere]. Returns {lowest, highest} cosine.
+std::pair<double, double> polarCosines(const V3d& o, const V3d& omega, double length, const Imath::Box3f& box,
+                                       double grow, double h) {
+    double centre = 0.0, radius = 0.0, halfDiagonal2 = 0.0;
+    V3d toCentre;
+    for (int a = 0; a < 3; ++a) {
+        const double half = 0.5 * (double(box.max[a]) - double(box.min[a]));
+        toCentre[a] = 0.5 * (double(box.min[a]) + double(box.max[a])) - o[a];
+        centre += omega[a] * toCentre[a];
+        radius += std::abs(omega[a]) * (half + grow);
+        halfDiagonal2 += half * half;
+    }
+    const double rMax = (toCentre - omega * centre).length() + std::sqrt(halfDiagonal2) + 2.0 * grow;
+    const double sMin = -(centre + radius) - grow, sMax = length - (centre - radius) + grow;
+    const auto cosine = [](double s, double r) { return s / std::sqrt(s * s + r * r); };
+    const double low = cosine(sMin, sMin < 0.0 ? h : rMax), high = cosine(sMax, sMax > 0.0 ? h : rMax);
+    if (!std::isfinite(low) || !std::isfinite(high)) return {-1.0, 1.0};
+    return {std::clamp(low, -1.0, 1.0), std::clamp(high, -1.0, 1.0)};
+}
+
+// The largest |d ln HG / d psi| over all scattering angles psi: at cos psi = 2g / (1 + g^2),
+// 3 |g| / (1 - g^2).
+double hgLogSlope(float g) { return 3.0 * std::abs(double(g)) / (1.0 - double(g) * double(g)); }
+// The relative error of a float HG value whose denominator is off by kHgDenominatorSlack.
+double hgFloatFactor(float g) {
+    const double q = 1.0 - std::abs(double(g));
+    return 1.0 + 3.0 * kHgDenominatorSlack / (q * q);
+}
 }  // namespace
 
 ClusterBound::ClusterBound(const Scene& scene, const LightTree& tree, ClusterBoundSettings settings)
     : scene_(scene), tree_(tree), settings_(settings), leaves_(tree) {
     for (const auto& m : scene.media()) {
         for (int c = 0; c < 3; ++c) maxSigmaS_[c] = std::max(maxSigmaS_[c], m.sigmaS()[c]);
+        allIsotropic_ = allIsotropic_ && m.phase().isIsotropic();
     }
+    if (!allIsotropic_ && settings_.hgBound == HgBound::Cones) cones_ = DirectionCones(tree);
+}
+
+double ClusterBound::hgConeFactor(int32_t index, const CameraSegment& segment, double h, double slack,
+                                  double span) const {
+    const LightTreeNode& node = tree_.nodes()[index];
+    const DirectionCone& vrlCone = cones_[index];
+    // Rounded sample points turn directions by at most about 2 slack / h (and a
+    // cosine by at most as much as its angle).
+    const double widen = 2.0 * slack / h + 1e-6;
+    const V3d o = toD(segment.origin), omega = toD(segment.direction).normalized();
+    // Polar cosines of toU about omega; the angle at u is pi minus the polar angle.
+    const auto [polarLow, polarHigh] = polarCosines(o, omega, double(segment.length), node.box, slack, h);
+    const double uLow = std::max(-1.0, -polarHigh - widen), uHigh = std::min(1.0, -polarLow + widen);
+    // The angle at v: within the VRL cone's polar spread of toU's polar angles.
+    const AngleRange polar{std::max(0.0, std::acos(polarHigh) - widen), std::min(kPiD, std::acos(polarLow) + widen)};
+    const double alpha = vrlCone.isSphere() ? kPiD : double(vrlCone.halfAngle);
+    const double thetaA = angleD(toD(vrlCone.axis), omega);  // atan2: exact for a float-rounded axis
+    const AngleRange aPolar{std::max(0.0, thetaA - alpha - 1e-7), std::min(kPiD, thetaA + alpha + 1e-7)};
+    const double lowest = aPolar.low + polar.low, highest = aPolar.high + polar.high;
+    const double vAngleLow = std::max({0.0, polar.low - aPolar.high, aPolar.low - polar.high});
+    const double vAngleHigh = highest < kPiD ? highest : lowest > kPiD ? 2.0 * kPiD - lowest : kPiD;
+    const double vLow = std::cos(vAngleHigh), vHigh = std::cos(vAngleLow);
+    PhaseRange fv{kInfinity, 0.0};
+    double slope = 0.0, floatFactor = 1.0;
+    const auto extend = [&](const HomogeneousMedium& m) {
+        const PhaseRange r = hgRange(m.phase().g(), vLow, vHigh);
+        fv.low = std::min(fv.low, r.low), fv.high = std::max(fv.high, r.high);
+        slope = std::max(slope, hgLogSlope(m.phase().g()));
+        floatFactor = std::max(floatFactor, hgFloatFactor(m.phase().g()));
+    };
+    if (node.medium >= 0)
+        extend(scene_.media()[node.medium]);
+    else
+        for (const auto& m : scene_.media()) extend(m);
+    const float gU = scene_.media()[segment.medium].phase().g();
+    const PhaseRange fu = hgRange(gU, uLow, uHigh);
+    const double high = fv.high * fu.high, low = fv.low * fu.low;
+    if (!std::isfinite(high)) return kInfinity;
+    // Within its bin, the sample's angles are at most span / (2 kHgBins) (plus rounding)
+    // from the bin centre's, where b_k was taken: f(u) f(v) <= smooth b_k.
+    const double halfBin = span / (2.0 * VrlEstimator::kHgBins) + widen;
+    const double smooth =
+        std::exp((slope + hgLogSlope(gU)) * halfBin) * floatFactor * hgFloatFactor(gU) * (1.0 + 1e-4);
+    const double w = VrlEstimator::kHgUniformWeight;
+    return high / (w + (1.0 - w) * std::clamp(std::max(low / high, 1.0 / smooth), 0.0, 1.0));
+}
+
+double ClusterBound::phaseFactor(int32_t index, const CameraSegment& segment, double h, double slack,
+                                 double span) const {
+    const LightTreeNode& node = tree_.nodes()[index];
+    const double isotropic = double(kInv4Pi) * double(kInv4Pi);
+    if (allIsotropic_) return isotropic;
+    const HomogeneousMedium& cameraMedium = scene_.media()[segment.medium];
+    const bool involvesHg = !cameraMedium.phase().isIsotropic() ||
+                            (node.medium >= 0 ? !scene_.media()[node.medium].phase().isIsotropic() : true);
+    if (!involvesHg) return isotropic;
+    if (settings_.hgBound == HgBound::Epsilon) return isotropic * (1.0 + settings_.anisotropyEpsilon);
+    return hgConeFactor(index, segment, h, slack, span);
 }
 
 double ClusterBound::minimumDistance(int32_t index, const CameraSegment& segment) const {
@@ -45,19 +173,16 @@ Rgb ClusterBound::bound(int32_t index, const CameraSegment& segment, bool* lineC
     if (lineCrossesNode) *lineCrossesNode = !(h > 0.0);
     if (!(h > 0.0)) return Rgb(std::numeric_limits<float>::infinity());
     const HomogeneousMedium& cameraMedium = scene_.media()[segment.medium];
-    const HomogeneousMedium* vrlMedium = node.medium >= 0 ? &scene_.media()[node.medium] : nullptr;
-    const Rgb sigmaSV = vrlMedium ? vrlMedium->sigmaS() : maxSigmaS_;
-    const bool isotropic = cameraMedium.phase().isIsotropic() && (!vrlMedium || vrlMedium->phase().isIsotropic()) &&
-                           (vrlMedium || std::all_of(scene_.media().begin(), scene_.media().end(),
-                                                     [](const auto& m) { return m.phase().isIsotropic(); }));
-    double phase = double(kInv4Pi) * double(kInv4Pi);
-    if (!isotropic) phase *= 1.0 + settings_.anisotropyEpsilon;
+    const Rgb sigmaSV = node.medium >= 0 ? scene_.media()[node.medium].sigmaS() : maxSigmaS_;
+    const double span = maxSubtendedAngle(segment.length, h);
+    const double phase = phaseFactor(index, segment, h, slack, span);
+    if (!std::isfinite(phase)) return Rgb(std::numeric_limits<float>::infinity());
     // T_r(w) <= T_r(h_min) only if the segment between u and v stays in this one convex medium.
     Rgb between(1.0f);
     if (node.medium == segment.medium && cameraMedium.boundaryConvex()) between = cameraMedium.transmittance(float(h));
     // The node is estimated by its representative with flux Phi_C: the bound's
     // Phi L factor is Phi_C L_rep = the node's flux x length (<= Phi_C L_max, Eq. 11's).
-    const double scale = kRoundingMargin * phase * maxSubtendedAngle(segment.length, h) / h;
+    const double scale = kRoundingMargin * phase * span / h;
     return node.fluxLength * sigmaSV * cameraMedium.sigmaS() * segment.throughputBefore * between * float(scale);
 }
 

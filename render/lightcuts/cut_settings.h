@@ -7,9 +7,16 @@
 
 namespace vrl {
 
+// How VRL cuts bound the phase factor in Henyey-Greenstein media (cluster_bound.h).
+enum class HgBound : uint8_t {
+    Cones,    // proven: HG over the cones of VRL directions and of directions box -> segment
+    Epsilon,  // heuristic: the isotropic bound x (1 + anisotropyEpsilon) (the paper's)
+};
+
 struct ClusterBoundSettings {
     uint32_t exactDistanceBelow = 32;  // VRL nodes with at most this many VRLs: h_min from their segments
-    float anisotropyEpsilon = 1.0f;    // HG media: bound x (1 + epsilon)
+    HgBound hgBound = HgBound::Cones;  // VRL cuts; VPL cuts always use the epsilon heuristic
+    float anisotropyEpsilon = 1.0f;    // HgBound::Epsilon and VPL cuts: bound x (1 + epsilon)
     float glossyMargin = 2.0f;         // VRL-lit glossy surfaces: f|cos| towards the box's corners x this
 };
 

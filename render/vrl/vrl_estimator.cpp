@@ -166,8 +166,8 @@ Rgb VrlEstimator::sampleOnce(const Vrl& vrl, const CameraSegment& segment, Rng& 
     const double span = e.span;
     if (!(span > 0.0)) return Rgb(0.0f);
     const bool anisotropic = !mediumU.phase().isIsotropic() || !mediumV.phase().isIsotropic();
-    constexpr int kBins = 8;
-    constexpr double kUniformWeight = 0.25;
+    constexpr int kBins = kHgBins;
+    constexpr double kUniformWeight = kHgUniformWeight;
     std::array<double, kBins> binWeight{};
     double binTotal = 0.0;
     if (anisotropic) {

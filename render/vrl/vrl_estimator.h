@@ -36,6 +36,15 @@ float equiangularPdf(const Vec3& origin, const Vec3& direction, float length, co
 
 class VrlEstimator {
 public:
+    // Anisotropic media (either end HG): u's equiangular angle is drawn uniformly
+    // with probability kHgUniformWeight, else from a kHgBins-bin piecewise-constant
+    // fit of f(u) f(v) evaluated at the bins' centres. So the angle's pdf is at
+    // least kHgUniformWeight / span everywhere, and at least
+    // (kHgUniformWeight + (1 - kHgUniformWeight) min f / max f) / span: the HG
+    // cluster bound (cluster_bound.h) rests on both.
+    static constexpr int kHgBins = 8;
+    static constexpr double kHgUniformWeight = 0.25;
+
     // samplesPerVrl: (u, v) pairs averaged per VRL and segment.
     VrlEstimator(const Scene& scene, int samplesPerVrl);
 

@@ -75,6 +75,7 @@ v1::RenderParameters defaultRenderParameters(RenderMethod method) {
     p.set_max_cut(d.cut.maxCutSize);
     p.set_exact_distance_below(d.cut.bound.exactDistanceBelow);
     p.set_hg_epsilon(d.cut.bound.anisotropyEpsilon);
+    p.set_hg_epsilon_bound(d.cut.bound.hgBound == HgBound::Epsilon);
     p.set_partition_size(d.partitionSize);
     p.set_cut_size(d.cut.stochasticCutSize);
     p.set_vrl_sets(uint32_t(d.vrlSets));
@@ -217,6 +218,7 @@ ResolvedJob resolveJob(const std::filesystem::path& sceneFile, const v1::JobSpec
     s.cut.maxCutSize = p.max_cut();
     s.cut.bound.exactDistanceBelow = p.exact_distance_below();
     s.cut.bound.anisotropyEpsilon = p.hg_epsilon();
+    s.cut.bound.hgBound = p.hg_epsilon_bound() ? HgBound::Epsilon : HgBound::Cones;
     s.partitionSize = p.partition_size();
     if (p.cut_size() > 0) s.cut.stochasticCutSize = p.cut_size();
     s.vrlSets = p.vrl_sets() > 0 ? int(p.vrl_sets()) : 1;
