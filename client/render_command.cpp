@@ -252,6 +252,13 @@ int runRender(const RenderCommandOptions& o, const CLI::App& command) {
         std::fprintf(stderr, "  bound exceeded by %llu of %llu cluster estimates (%.4f%%)\n",
                      (unsigned long long)stats.boundExceeded, (unsigned long long)stats.boundedEstimates,
                      stats.boundedEstimates ? 100.0 * double(stats.boundExceeded) / double(stats.boundedEstimates) : 0.0);
+        if (settings.method == RenderMethod::VrlLightcuts) {
+            if (settings.cut.bound.hgBound == HgBound::Cones)
+                std::fprintf(stderr, "  Henyey-Greenstein media: the proven bound (cones of directions)\n");
+            else
+                std::fprintf(stderr, "  Henyey-Greenstein media: the heuristic bound, isotropic x (1 + %g)\n",
+                             double(settings.cut.bound.anisotropyEpsilon));
+        }
     }
     return 0;
 }

@@ -107,6 +107,22 @@ TEST(ResolveJob, ATimeLimitMakesTheSampleCountACap) {
     }
 }
 
+// The HG bound of VRL cuts: the proven cone bound unless the spec asks for the
+// (1 + hg_epsilon) heuristic; the defaults the client starts from say "cones".
+TEST(ResolveJob, HgBoundIsTheProvenOneUnlessTheHeuristicIsAskedFor) {
+    const test::TempDir dir("vrl-job-scene");
+    const auto scene = writeScene(dir, "");
+    v1::JobSpec spec = specWithMethod("vrl-lightcuts");
+    EXPECT_FALSE(rpc::defaultRenderParameters(RenderMethod::VrlLightcuts).hg_epsilon_bound());
+    RenderSettings s = rpc::resolveJob(scene, spec, {}).settings;
+    EXPECT_EQ(s.cut.bound.hgBound, HgBound::Cones);
+    spec.mutable_parameters()->set_hg_epsilon_bound(true);
+    spec.mutable_parameters()->set_hg_epsilon(0.5f);
+    s = rpc::resolveJob(scene, spec, {}).settings;
+    EXPECT_EQ(s.cut.bound.hgBound, HgBound::Epsilon);
+    EXPECT_EQ(s.cut.bound.anisotropyEpsilon, 0.5f);
+}
+
 TEST(ResolveJob, VrlSetsAreForVrlStochasticWithinTheVrlLimit) {
     const test::TempDir dir("vrl-job-scene");
     const auto scene = writeScene(dir, "");

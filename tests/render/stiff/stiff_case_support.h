@@ -162,7 +162,7 @@ bool allIsotropic(const Scene& scene);
 // Every node of `tree` against every segment: a crossing line gives an infinite
 // bound; otherwise `samples` estimates of the node (its representative carrying the
 // cluster flux, as the cut evaluates it) must not exceed the bound in any channel.
-// Counted into boundChecks / boundViolations (asserted only in isotropic media).
+// Counted into boundChecks / boundViolations (asserted: the default bound is proven in HG media too).
 void checkClusterBounds(CaseResult& r, const Scene& scene, const LightTree& tree,
                         const std::vector<CameraSegment>& segments, int samples, uint64_t seed);
 

@@ -3,7 +3,7 @@
 // checking that every value it produces is finite and non-negative, that it
 // agrees with a reference (analytic answer, quadrature, the path tracer, or
 // plain VRLs against Lightcuts at threshold 0) within a stated tolerance, and
-// that the Lightcuts bounds hold where they are proven (isotropic media).
+// that the Lightcuts bounds hold where they are proven (VRL cuts; VPL cuts in isotropic media).
 //
 // Groups:
 //   media     sigma_t from 1e-6 to 1e4, albedo 0 .. 0.9999, HG g from -0.99 to
@@ -49,7 +49,7 @@ struct CaseResult {
     bool nonNegative = true;     // every checked value >= 0
     std::vector<Comparison> comparisons;
     // Bound checks: (node, sample) pairs where bound >= estimate was tested, and
-    // how many failed. `boundAsserted`: the bound is proven here (isotropic), so a
+    // how many failed. `boundAsserted`: the bound is proven here (VRL cuts, isotropic VPL cuts), so a
     // violation fails the case; otherwise (HG heuristic) violations are reported.
     uint64_t boundChecks = 0, boundViolations = 0;
     bool boundAsserted = true;
