@@ -9,7 +9,7 @@ namespace vrl {
 
 // How VRL cuts bound the phase factor in Henyey-Greenstein media (cluster_bound.h).
 enum class HgBound : uint8_t {
-    Cones,    // proven: HG over the cones of VRL directions and of directions box -> segment
+    Cones,    // proven: HG over the cones of VRL directions and the polar angles about the camera ray
     Epsilon,  // heuristic: the isotropic bound x (1 + anisotropyEpsilon) (the paper's)
 };
 

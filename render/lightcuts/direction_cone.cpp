@@ -51,7 +51,8 @@ DirectionCone DirectionCone::merge(const DirectionCone& a, const DirectionCone& 
     // Turn axis a towards b by (spread - alpha) in their plane.
     V3d across = axisB - axisA * axisA.dot(axisB);
     const double acrossLength = across.length();
-    if (!(acrossLength > 1e-12)) return sphere();  // opposite axes
+    if (!(acrossLength > 1e-12))  // (nearly) parallel axes: the wider cone, grown by theta; opposite: the sphere
+        return axisA.dot(axisB) > 0.0 ? DirectionCone{a.axis, storedHalfAngle(std::max(alpha, beta) + theta)} : sphere();
     across /= acrossLength;
     const double turn = spread - alpha;
     V3d axis = axisA * std::cos(turn) + across * std::sin(turn);

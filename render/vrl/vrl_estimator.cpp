@@ -174,11 +174,17 @@ Rgb VrlEstimator::sampleOnce(const Vrl& vrl, const CameraSegment& segment, Rng& 
         // In the plane of the camera line and xv, the direction from xv to u(theta) is
         // w sin(theta) - e cos(theta), e the unit offset of xv from the line: so
         // cos to the VRL = sin(theta) (d.w) - cos(theta) (d.e), cos to the camera = -sin(theta).
-        const Vec3 foot = segment.origin + segment.direction * float(e.delta);
-        const Vec3 offset = xv - foot;
-        const float offsetLength = offset.length();
-        const Vec3 unitOffset = offsetLength > 0.0f ? offset / offsetLength : Frame::fromNormal(segment.direction).s;
-        const double dw = vrl.direction.dot(segment.direction), de = vrl.direction.dot(unitOffset);
+        // e in double, orthogonal to w to double precision: a float foot point would tilt
+        // it towards w and scale the bins' cosines (the HG cluster bound relies on them).
+        const Imath::V3d w = Imath::V3d(segment.direction.x, segment.direction.y, segment.direction.z).normalized();
+        const Imath::V3d r(double(xv.x) - segment.origin.x, double(xv.y) - segment.origin.y,
+                           double(xv.z) - segment.origin.z);
+        const Imath::V3d offset = r - w * w.dot(r);
+        const double offsetLength = offset.length();
+        const Vec3 frameS = Frame::fromNormal(segment.direction).s;
+        const Imath::V3d unitOffset = offsetLength > 0.0 ? offset / offsetLength : Imath::V3d(frameS.x, frameS.y, frameS.z);
+        const Imath::V3d d(vrl.direction.x, vrl.direction.y, vrl.direction.z);
+        const double dw = d.dot(w), de = d.dot(unitOffset);
         const double step = span / kBins;
         // cos, sin of thetaA + step / 2 (cos thetaA = h / r, sin thetaA = -delta / r), then
         // rotated by step per bin (one sincos pair); only here, not for isotropic media.
