@@ -22,6 +22,7 @@
 // above their bound; then, at each heuristic point, the cone bound's time at
 // the same relative RMSE (log-log interpolation between its bracketing points)
 // over the heuristic's time: the "slower at equal error" ratio.
+#include "bench/bench_lights.h"
 #include "render/core/timing.h"
 #include "render/image/image_metrics.h"
 #include "render/integrators/transport_integrator.h"
@@ -229,14 +230,10 @@ int main(int argc, char** argv) {
         std::printf("scene %s%s, %dx%d, part %s only: HG bounds, cones against epsilon = %g\n", scenePath.c_str(),
                     defined.c_str(), w, h, surfacePart ? "(c) medium-to-surface" : "(d) medium-to-medium", hgEpsilon);
         for (uint64_t n : counts) {
-            LightTracingSettings tracing;
-            tracing.targetVrls = n;
-            tracing.maxDepth = description.integrator.maxDepth;
-            const VrlSet vrls = traceVrls(*scene, tracing);
-            const LightTree tree = LightTree::build(vrls.vrls);
+            const bench::BenchLights lights = bench::traceAndBuild(*scene, n, description.integrator.maxDepth);
             const int s = n > strideAbove ? stride : 1;
-            std::printf("%zu VRLs%s\n", vrls.vrls.size(), s > 1 ? " (1/16 of the pixels)" : "");
-            compareHgBounds(*scene, vrls, tree, errors, hgEpsilon, s, double((w + s - 1) / s) * ((h + s - 1) / s),
+            std::printf("%zu VRLs%s\n", lights.vrls.vrls.size(), s > 1 ? " (1/16 of the pixels)" : "");
+            compareHgBounds(*scene, lights.vrls, lights.tree, errors, hgEpsilon, s, double((w + s - 1) / s) * ((h + s - 1) / s),
                             surfacePart);
         }
         return 0;
@@ -248,22 +245,17 @@ int main(int argc, char** argv) {
                 "cut_ns");
     const double cores = double(tbb::info::default_concurrency());
     for (uint64_t n : counts) {
-        LightTracingSettings tracing;
-        tracing.targetVrls = n;
-        tracing.maxDepth = description.integrator.maxDepth;
-        auto start = std::chrono::steady_clock::now();
-        const VrlSet vrls = traceVrls(*scene, tracing);
-        const double traceSeconds = secondsSince(start);
-        start = std::chrono::steady_clock::now();
-        const LightTree tree = LightTree::build(vrls.vrls);
-        const double buildSeconds = secondsSince(start);
+        const bench::BenchLights lights = bench::traceAndBuild(*scene, n, description.integrator.maxDepth);
+        const VrlSet& vrls = lights.vrls;
+        const LightTree& tree = lights.tree;
+        const double traceSeconds = lights.traceSeconds, buildSeconds = lights.buildSeconds;
         const int s = n > strideAbove ? stride : 1;
         const double pixels = double((w + s - 1) / s) * ((h + s - 1) / s);
         const Shading cuts = shade(*scene, vrls, &tree, error, s, 1, surfacePart);
         const Shading plain = shade(*scene, vrls, nullptr, error, s, 1, surfacePart);
         std::string global = "-", gather = "-";
         if (n <= globalMax) {
-            start = std::chrono::steady_clock::now();
+            const auto start = std::chrono::steady_clock::now();
             const LightTree globalTree = LightTree::build(vrls.vrls, LightTreeSettings{uint32_t(vrls.vrls.size()), 0});
             global = std::to_string(secondsSince(start)).substr(0, 7);
             const Shading globalCuts = shade(*scene, vrls, &globalTree, error, s, 1, surfacePart);

@@ -32,6 +32,7 @@
 // extrapolation: the best measured point at or under each comparison time.
 // Timings are wall-clock, one run each, on whatever cores TBB gets: compare
 // ratios within one run, not seconds.
+#include "bench/bench_lights.h"
 #include "render/core/timing.h"
 #include "render/image/image_metrics.h"
 #include "render/integrators/transport_integrator.h"
@@ -306,11 +307,9 @@ int main(int argc, char** argv) {
     std::printf("errors: relative RMSE against the same VRL set's converged part (mean of %d plain renders)\n",
                 referenceRuns);
     for (uint64_t n : counts) {
-        LightTracingSettings tracing;
-        tracing.targetVrls = n;
-        tracing.maxDepth = description.integrator.maxDepth;
-        const VrlSet vrls = traceVrls(*scene, tracing);
-        const LightTree tree = LightTree::build(vrls.vrls);
+        const bench::BenchLights lights = bench::traceAndBuild(*scene, n, description.integrator.maxDepth);
+        const VrlSet& vrls = lights.vrls;
+        const LightTree& tree = lights.tree;
         const int s = n > strideAbove ? stride : 1;
         std::printf("\nN = %zu VRLs%s\n", vrls.vrls.size(), s > 1 ? " (1/16 of the pixels)" : "");
         std::vector<Image> references;

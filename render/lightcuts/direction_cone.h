@@ -52,8 +52,6 @@ public:
     explicit DirectionCones(const LightTree& tree);
 
     const DirectionCone& operator[](int32_t node) const { return cones_[size_t(node)]; }
-    bool empty() const { return cones_.empty(); }
-    size_t memoryBytes() const { return cones_.capacity() * sizeof(DirectionCone); }
 
 private:
     std::vector<DirectionCone> cones_;

@@ -650,21 +650,26 @@ TEST(ClusterBound, BoundsIsotropicEstimateAcrossMedia) {
 // 1 .. 1000 units down long camera segments (seed 108, 2 x 400 trees, ~1e6 triples).
 // Distances down to 1e-4 are then only a few hundred float steps of the coordinates:
 // the bound must absorb the arithmetic's absolute rounding, not only 0.1%.
-TEST(ClusterBound, BoundsIsotropicEstimateFarFromTheOrigin) {
-    const auto scene = unboundedScene(Rgb(0.2f, 0.5f, 1.0f), Rgb(0.0f), 0.0f);
+// Both far regimes, `trees` trees each, seeds `seed` and seed + 1: no violation.
+void expectNoViolationFarFromTheOrigin(const Scene& scene, uint64_t seed, int trees, const std::string& name) {
     SamplingPlan plan;
-    plan.seed = 108;
-    plan.trees = 400;
+    plan.seed = seed;
+    plan.trees = trees;
     plan.farFraction = 1.0;
-    BoundCheck r = checkBound(*scene, plan);
-    print("isotropic, unbounded, centred up to 50 from the origin", r);
+    BoundCheck r = checkBound(scene, plan);
+    print((name + ", centred up to 50 from the origin").c_str(), r);
     expectNoViolation(r);
-    plan.seed = 109;
+    plan.seed = seed + 1;
     plan.farFraction = 0.0;
     plan.alongMax = 1000.0;
-    r = checkBound(*scene, plan);
-    print("isotropic, unbounded, VRLs up to 1000 down the segment", r);
+    r = checkBound(scene, plan);
+    print((name + ", VRLs up to 1000 down the segment").c_str(), r);
     expectNoViolation(r);
+}
+
+TEST(ClusterBound, BoundsIsotropicEstimateFarFromTheOrigin) {
+    const auto scene = unboundedScene(Rgb(0.2f, 0.5f, 1.0f), Rgb(0.0f), 0.0f);
+    expectNoViolationFarFromTheOrigin(*scene, 108, 400, "isotropic, unbounded");
 }
 
 // The tight case of the derivation, deterministically: a VRL parallel to the camera
@@ -870,19 +875,7 @@ TEST(ClusterBound, HgConeBoundAcrossMediaAndFarAway) {
         expectNoViolation(r);
     }
     const auto hg = unboundedScene(Rgb(0.2f, 0.5f, 1.0f), Rgb(0.0f), 0.9f);
-    plan = SamplingPlan{};
-    plan.seed = 121;
-    plan.trees = 300;
-    plan.farFraction = 1.0;
-    BoundCheck r = checkBound(*hg, plan);
-    print("HG cones g=0.9, centred up to 50 from the origin", r);
-    expectNoViolation(r);
-    plan.seed = 122;
-    plan.farFraction = 0.0;
-    plan.alongMax = 1000.0;
-    r = checkBound(*hg, plan);
-    print("HG cones g=0.9, VRLs up to 1000 down the segment", r);
-    expectNoViolation(r);
+    expectNoViolationFarFromTheOrigin(*hg, 121, 300, "HG cones g=0.9");
 }
 
 // The cone bound is the isotropic bound with its phase factor 1/(4 pi)^2 replaced by
