@@ -195,7 +195,9 @@ int main(int argc, char** argv) {
     app.add_flag("--hg-compare", hgCompare,
                  "Compare the proven HG cone bound with the (1 + --hg-epsilon) heuristic over --errors");
     app.add_option("--errors", errors, "--hg-compare: error thresholds (default 0.005 ... 2: the cone bound needs larger ones for the same error)");
-    app.add_option("--hg-epsilon", hgEpsilon, "--hg-compare: the heuristic's epsilon (default 1)");
+    app.add_option("--hg-epsilon", hgEpsilon,
+                   "--hg-compare: the heuristic's epsilon (default 1); otherwise, given: the cuts bound HG media by "
+                   "this heuristic instead of the proven bound (as builds before the proven bound did)");
     app.add_flag("-v,--verbose", verbose, "Log the light tree build's phases (spdlog debug)");
     CLI11_PARSE(app, argc, argv);
     const bool surfacePart = part == "medium-surface";
@@ -238,8 +240,12 @@ int main(int argc, char** argv) {
         }
         return 0;
     }
+    ClusterBoundSettings bound;
+    if (app.count("--hg-epsilon") > 0) bound.hgBound = HgBound::Epsilon, bound.anisotropyEpsilon = hgEpsilon;
     std::printf("scene %s%s, %dx%d, error threshold %.3f, part %s only\n", scenePath.c_str(), defined.c_str(), w, h,
                 error, surfacePart ? "(c) medium-to-surface" : "(d) medium-to-medium");
+    if (bound.hgBound == HgBound::Epsilon)
+        std::printf("HG media: the heuristic bound, isotropic x (1 + %g)\n", double(bound.anisotropyEpsilon));
     std::printf("%9s %8s %9s %8s %9s %10s %9s %9s %8s %9s %8s %8s %8s %9s %8s\n", "VRLs", "trace_s", "build_s", "tree_MB",
                 "global_s", "gatherX", "plain_s", "cuts_s", "speedup", "relRMSE", "#Eval", "#Inter", "cut", "plain_ns",
                 "cut_ns");
@@ -251,14 +257,14 @@ int main(int argc, char** argv) {
         const double traceSeconds = lights.traceSeconds, buildSeconds = lights.buildSeconds;
         const int s = n > strideAbove ? stride : 1;
         const double pixels = double((w + s - 1) / s) * ((h + s - 1) / s);
-        const Shading cuts = shade(*scene, vrls, &tree, error, s, 1, surfacePart);
+        const Shading cuts = shade(*scene, vrls, &tree, error, s, 1, surfacePart, bound);
         const Shading plain = shade(*scene, vrls, nullptr, error, s, 1, surfacePart);
         std::string global = "-", gather = "-";
         if (n <= globalMax) {
             const auto start = std::chrono::steady_clock::now();
             const LightTree globalTree = LightTree::build(vrls.vrls, LightTreeSettings{uint32_t(vrls.vrls.size()), 0});
             global = std::to_string(secondsSince(start)).substr(0, 7);
-            const Shading globalCuts = shade(*scene, vrls, &globalTree, error, s, 1, surfacePart);
+            const Shading globalCuts = shade(*scene, vrls, &globalTree, error, s, 1, surfacePart, bound);
             gather = std::to_string(double(cuts.total.evaluated) / std::max(1u, globalCuts.total.evaluated)).substr(0, 5);
         }
         const ImageErrorMetrics m = compareImages(plain.image, cuts.image);

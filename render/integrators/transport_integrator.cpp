@@ -23,8 +23,11 @@ TransportIntegrator::TransportIntegrator(const Scene& scene, const VrlSet& vrls,
         stochastic_ = std::make_unique<StochasticLightcutsEstimator>(scene, *tree_, estimator_, surfaceEstimator_,
                                                                      settings.cut);
     else if (tree_) {
-        lightcuts_ = std::make_unique<LightcutsEstimator>(scene, *tree_, estimator_, settings.cut);
-        surfaceLightcuts_ = std::make_unique<SurfaceLightcutsEstimator>(scene, *tree_, surfaceEstimator_, settings.cut);
+        // One set of direction cones for both cuts' bounds, only where a medium is anisotropic.
+        if (DirectionCones::neededFor(scene.media())) cones_ = std::make_unique<DirectionCones>(*tree_);
+        lightcuts_ = std::make_unique<LightcutsEstimator>(scene, *tree_, estimator_, settings.cut, cones_.get());
+        surfaceLightcuts_ =
+            std::make_unique<SurfaceLightcutsEstimator>(scene, *tree_, surfaceEstimator_, settings.cut, cones_.get());
     }
     if (settings.maxDepth >= 0 && settings.maxDepth < 16 && scene.hasSpecularSurfaces() &&
         (settings.transports.has(TransportPart::Multiple) ||

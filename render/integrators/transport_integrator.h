@@ -99,6 +99,7 @@ private:
     VrlEstimator estimator_;
     VrlSurfaceEstimator surfaceEstimator_;
     const LightTree* tree_;
+    std::unique_ptr<DirectionCones> cones_;  // vrl-lightcuts with an HG medium: shared by both cuts' bounds
     std::unique_ptr<LightcutsEstimator> lightcuts_;
     std::unique_ptr<SurfaceLightcutsEstimator> surfaceLightcuts_;
     std::unique_ptr<StochasticLightcutsEstimator> stochastic_;

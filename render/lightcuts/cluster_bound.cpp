@@ -17,31 +17,9 @@ namespace {
 // carries this relative margin.
 constexpr double kRoundingMargin = 1.001;
 constexpr double kPiD = 3.14159265358979323846;
-constexpr double kInv4PiD = 1.0 / (4.0 * kPiD);
-// HG's float denominator 1 + g^2 - 2 g cos is off by a few 1e-7 at most.
-constexpr double kHgDenominatorSlack = 2e-6;
 
 using V3d = Imath::V3d;
 V3d toD(const Vec3& v) { return {v.x, v.y, v.z}; }
-double angleD(const V3d& a, const V3d& b) { return std::atan2(a.cross(b).length(), a.dot(b)); }
-
-struct PhaseRange {
-    double low, high;
-};
-
-// Bounds of one HG phase function (float g, as evaluated in float by
-// PhaseFunction::evalCosine) over scattering cosines in [cosLow, cosHigh].
-PhaseRange hgRange(float g, double cosLow, double cosHigh) {
-    if (g == 0.0f) return {double(kInv4Pi), double(kInv4Pi)};  // evalCosine's value
-    const double gd = g;
-    const double numerator = kInv4PiD * (1.0 - gd * gd);
-    // Increasing in the cosine for g > 0: the largest value at the largest cosine.
-    const double cosNear = g > 0.0f ? cosHigh : cosLow, cosFar = g > 0.0f ? cosLow : cosHigh;
-    const double near = 1.0 + gd * gd - 2.0 * gd * cosNear - kHgDenominatorSlack;
-    const double far = 1.0 + gd * gd - 2.0 * gd * cosFar + kHgDenominatorSlack;
-    const double high = near > 0.0 ? numerator / (near * std::sqrt(near)) * (1.0 + 1e-5) : kInfinity;
-    return {numerator / (far * std::sqrt(far)) * (1.0 - 1e-5), high};
-}
 
 struct AngleRange {
     double low, high;  // in [0, pi]
@@ -73,29 +51,22 @@ std::pair<double, double> polarCosines(const V3d& o, const V3d& omega, double le
     return {std::clamp(low, -1.0, 1.0), std::clamp(high, -1.0, 1.0)};
 }
 
-// The largest |d ln HG / d psi| over all scattering angles psi: at cos psi = 2g / (1 + g^2),
-// 3 |g| / (1 - g^2).
-double hgLogSlope(float g) { return 3.0 * std::abs(double(g)) / (1.0 - double(g) * double(g)); }
-// The relative error of a float HG value whose denominator is off by kHgDenominatorSlack.
-double hgFloatFactor(float g) {
-    const double q = 1.0 - std::abs(double(g));
-    return 1.0 + 3.0 * kHgDenominatorSlack / (q * q);
-}
 }  // namespace
 
-ClusterBound::ClusterBound(const Scene& scene, const LightTree& tree, ClusterBoundSettings settings)
+ClusterBound::ClusterBound(const Scene& scene, const LightTree& tree, ClusterBoundSettings settings,
+                           const DirectionCones* cones)
     : scene_(scene), tree_(tree), settings_(settings), leaves_(tree) {
     for (const auto& m : scene.media()) {
         for (int c = 0; c < 3; ++c) maxSigmaS_[c] = std::max(maxSigmaS_[c], m.sigmaS()[c]);
         allIsotropic_ = allIsotropic_ && m.phase().isIsotropic();
     }
-    if (!allIsotropic_ && settings_.hgBound == HgBound::Cones) cones_ = DirectionCones(tree);
+    if (!allIsotropic_ && settings_.hgBound == HgBound::Cones) cones_ = DirectionCones::shareOrBuild(cones, tree, ownedCones_);
 }
 
 double ClusterBound::hgConeFactor(int32_t index, const CameraSegment& segment, double h, double slack,
                                   double span) const {
     const LightTreeNode& node = tree_.nodes()[index];
-    const DirectionCone& vrlCone = cones_[index];
+    const DirectionCone& vrlCone = (*cones_)[index];
     // Rounded sample points turn directions by at most about 2 slack / h (and a
     // cosine by at most as much as its angle).
     const double widen = 2.0 * slack / h + 1e-6;
@@ -106,33 +77,33 @@ double ClusterBound::hgConeFactor(int32_t index, const CameraSegment& segment, d
     // The angle at v: within the VRL cone's polar spread of toU's polar angles.
     const AngleRange polar{std::max(0.0, std::acos(polarHigh) - widen), std::min(kPiD, std::acos(polarLow) + widen)};
     const double alpha = vrlCone.isSphere() ? kPiD : double(vrlCone.halfAngle);
-    const double thetaA = angleD(toD(vrlCone.axis), omega);  // atan2: exact for a float-rounded axis
+    const double thetaA = angleBetween(vrlCone.axis, segment.direction);  // atan2: exact for a float-rounded axis
     const AngleRange aPolar{std::max(0.0, thetaA - alpha - 1e-7), std::min(kPiD, thetaA + alpha + 1e-7)};
     const double lowest = aPolar.low + polar.low, highest = aPolar.high + polar.high;
     const double vAngleLow = std::max({0.0, polar.low - aPolar.high, aPolar.low - polar.high});
     const double vAngleHigh = highest < kPiD ? highest : lowest > kPiD ? 2.0 * kPiD - lowest : kPiD;
     const double vLow = std::cos(vAngleHigh), vHigh = std::cos(vAngleLow);
-    PhaseRange fv{kInfinity, 0.0};
+    PhaseFunction::ValueRange fv{kInfinity, 0.0};
     double slope = 0.0, floatFactor = 1.0;
     const auto extend = [&](const HomogeneousMedium& m) {
-        const PhaseRange r = hgRange(m.phase().g(), vLow, vHigh);
+        const PhaseFunction::ValueRange r = m.phase().valueRange(vLow, vHigh);
         fv.low = std::min(fv.low, r.low), fv.high = std::max(fv.high, r.high);
-        slope = std::max(slope, hgLogSlope(m.phase().g()));
-        floatFactor = std::max(floatFactor, hgFloatFactor(m.phase().g()));
+        slope = std::max(slope, m.phase().logSlopeBound());
+        floatFactor = std::max(floatFactor, m.phase().floatErrorFactor());
     };
     if (node.medium >= 0)
         extend(scene_.media()[node.medium]);
     else
         for (const auto& m : scene_.media()) extend(m);
-    const float gU = scene_.media()[segment.medium].phase().g();
-    const PhaseRange fu = hgRange(gU, uLow, uHigh);
+    const PhaseFunction& phaseU = scene_.media()[segment.medium].phase();
+    const PhaseFunction::ValueRange fu = phaseU.valueRange(uLow, uHigh);
     const double high = fv.high * fu.high, low = fv.low * fu.low;
     if (!std::isfinite(high)) return kInfinity;
     // Within its bin, the sample's angles are at most span / (2 kHgBins) (plus rounding)
     // from the bin centre's, where b_k was taken: f(u) f(v) <= smooth b_k.
     const double halfBin = span / (2.0 * VrlEstimator::kHgBins) + widen;
     const double smooth =
-        std::exp((slope + hgLogSlope(gU)) * halfBin) * floatFactor * hgFloatFactor(gU) * (1.0 + 1e-4);
+        std::exp((slope + phaseU.logSlopeBound()) * halfBin) * floatFactor * phaseU.floatErrorFactor() * (1.0 + 1e-4);
     const double w = VrlEstimator::kHgUniformWeight;
     return high / (w + (1.0 - w) * std::clamp(std::max(low / high, 1.0 / smooth), 0.0, 1.0));
 }

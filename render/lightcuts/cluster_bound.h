@@ -63,6 +63,7 @@
 #include "render/lightcuts/light_tree.h"
 #include "render/vrl/camera_segment.h"
 
+#include <memory>
 #include <vector>
 
 namespace vrl {
@@ -72,7 +73,10 @@ class Scene;
 
 class ClusterBound {
 public:
-    ClusterBound(const Scene& scene, const LightTree& tree, ClusterBoundSettings settings = {});
+    // `cones`: the tree's DirectionCones when the caller shares them between bounds
+    // (TransportIntegrator); built here when needed and not given.
+    ClusterBound(const Scene& scene, const LightTree& tree, ClusterBoundSettings settings = {},
+                 const DirectionCones* cones = nullptr);
 
     // RGB bound for `node` against `segment`; +infinity when the
     // camera line passes through the node (h_min = 0).
@@ -92,7 +96,9 @@ private:
     Rgb maxSigmaS_{0.0f};  // over all media: for nodes spanning several
     bool allIsotropic_ = true;
     LeafSegments leaves_;
-    DirectionCones cones_;  // HgBound::Cones in a scene with an HG medium; else empty
+    // HgBound::Cones in a scene with an HG medium: the tree's cones (shared or owned); else null.
+    const DirectionCones* cones_ = nullptr;
+    std::unique_ptr<DirectionCones> ownedCones_;
 };
 
 }  // namespace vrl

@@ -64,6 +64,10 @@ DirectionCone DirectionCone::merge(const DirectionCone& a, const DirectionCone& 
     return {stored, storedHalfAngle(needed)};
 }
 
+bool DirectionCones::neededFor(const std::vector<HomogeneousMedium>& media) {
+    return std::any_of(media.begin(), media.end(), [](const HomogeneousMedium& m) { return !m.phase().isIsotropic(); });
+}
+
 DirectionCones::DirectionCones(const LightTree& tree) {
     if (tree.empty()) return;
     const auto& nodes = tree.nodes();

@@ -24,7 +24,9 @@
 
 #include "render/core/geometry.h"
 #include "render/lightcuts/light_tree.h"
+#include "render/media/homogeneous_medium.h"
 
+#include <memory>
 #include <vector>
 
 namespace vrl {
@@ -52,6 +54,15 @@ public:
     explicit DirectionCones(const LightTree& tree);
 
     const DirectionCone& operator[](int32_t node) const { return cones_[size_t(node)]; }
+    // `shared` if given, else cones built into `owned`: what a bound keeps a pointer to.
+    static const DirectionCones* shareOrBuild(const DirectionCones* shared, const LightTree& tree,
+                                              std::unique_ptr<DirectionCones>& owned) {
+        if (shared) return shared;
+        owned = std::make_unique<DirectionCones>(tree);
+        return owned.get();
+    }
+    // Whether a scene's bounds need cones: some medium is anisotropic.
+    static bool neededFor(const std::vector<HomogeneousMedium>& media);
 
 private:
     std::vector<DirectionCone> cones_;

@@ -22,12 +22,51 @@ float phaseMaximum(const PhaseFunction& phase) {
 
 }  // namespace
 
-SurfaceClusterBound::SurfaceClusterBound(const Scene& scene, const LightTree& tree, ClusterBoundSettings settings)
+SurfaceClusterBound::SurfaceClusterBound(const Scene& scene, const LightTree& tree, ClusterBoundSettings settings,
+                                         const DirectionCones* cones)
     : scene_(scene), tree_(tree), settings_(settings), leaves_(tree) {
     for (const auto& m : scene.media()) {
         for (int c = 0; c < 3; ++c) maxSigmaS_[c] = std::max(maxSigmaS_[c], m.sigmaS()[c]);
         maxPhase_ = std::max(maxPhase_, phaseMaximum(m.phase()));
     }
+    if (DirectionCones::neededFor(scene.media())) cones_ = DirectionCones::shareOrBuild(cones, tree, ownedCones_);
+}
+
+double SurfaceClusterBound::phaseBound(int32_t index, const Vec3& x, double slack, double d) const {
+    const LightTreeNode& node = tree_.nodes()[index];
+    const HomogeneousMedium* vrlMedium = node.medium >= 0 ? &scene_.media()[node.medium] : nullptr;
+    if (!cones_) return vrlMedium ? phaseMaximum(vrlMedium->phase()) : maxPhase_;  // isotropic: 1/(4 pi)
+    double cosLow = -1.0, cosHigh = 1.0;
+    const Imath::V3d centre = (Imath::V3d(node.box.min) + Imath::V3d(node.box.max)) * 0.5;
+    const Imath::V3d toX = Imath::V3d(x) - centre;
+    const double distance = toX.length();
+    const double radius = 0.5 * (Imath::V3d(node.box.max) - Imath::V3d(node.box.min)).length() + slack;
+    const DirectionCone& cone = (*cones_)[index];
+    if (distance > radius && !cone.isSphere()) {
+        // Cosines of theta -+ (alpha + beta) by the addition formulas (one sincos); the
+        // rounding widening applies to the cosines (a cosine moves by at most its angle).
+        const Imath::V3d a = Imath::V3d(cone.axis).normalized();
+        const double cosTheta = std::clamp(a.dot(toX) / distance, -1.0, 1.0);
+        const double sinTheta = std::sqrt(std::max(0.0, 1.0 - cosTheta * cosTheta));
+        const double sinBeta = radius / distance, cosBeta = std::sqrt(std::max(0.0, 1.0 - sinBeta * sinBeta));
+        const double alpha = cone.halfAngle, sinAlpha = std::sin(alpha), cosAlpha = std::cos(alpha);
+        const double cosSpread = cosAlpha * cosBeta - sinAlpha * sinBeta;  // spread = alpha + beta
+        const double sinSpread = sinAlpha * cosBeta + cosAlpha * sinBeta;
+        const double widen = 2.0 * slack / d + 1e-6 + 1e-12;
+        // theta - spread <= 0 exactly when cos theta >= cos spread (both in [0, pi] when spread <= pi).
+        const bool spreadBelowPi = sinSpread >= 0.0 || cosSpread > 0.0;
+        if (spreadBelowPi) {
+            cosHigh = cosTheta >= cosSpread ? 1.0 : std::min(1.0, cosTheta * cosSpread + sinTheta * sinSpread + widen);
+            // theta + spread >= pi exactly when cos theta <= -cos spread.
+            cosLow = cosTheta <= -cosSpread ? -1.0 : std::max(-1.0, cosTheta * cosSpread - sinTheta * sinSpread - widen);
+        }
+    }
+    double high = 0.0;
+    if (vrlMedium)
+        high = vrlMedium->phase().valueRange(cosLow, cosHigh).high;
+    else
+        for (const auto& m : scene_.media()) high = std::max(high, m.phase().valueRange(cosLow, cosHigh).high);
+    return high;
 }
 
 bool SurfaceClusterBound::provenFor(const Bsdf& bsdf) { return bsdf.lambertianBound(Vec2(0.0f, 0.0f)).has_value(); }
@@ -94,7 +133,8 @@ Rgb SurfaceClusterBound::bound(int32_t index, const CameraPathSurface& x, bool* 
 
     const HomogeneousMedium* vrlMedium = node.medium >= 0 ? &scene_.media()[node.medium] : nullptr;
     const Rgb sigmaS = vrlMedium ? vrlMedium->sigmaS() : maxSigmaS_;
-    const double phase = vrlMedium ? phaseMaximum(vrlMedium->phase()) : maxPhase_;
+    const double phase = phaseBound(index, p, slack, d);
+    if (!std::isfinite(phase)) return Rgb(std::numeric_limits<float>::infinity());
     Rgb between(1.0f);
     if (vrlMedium && node.medium == x.medium && reflectsOnly && !shape.changesMedium && vrlMedium->boundaryConvex())
         between = vrlMedium->transmittance(float(d));

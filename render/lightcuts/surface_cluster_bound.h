@@ -18,9 +18,16 @@
 //   - f_s for a diffuse surface is rho(x)/pi whatever the directions (exact);
 //     a reflecting model is 0 for wi on the other geometric side than wo: if
 //     all of B lies there, the bound is 0.
-//   - f_p <= 1/(4 pi) (isotropic); Henyey-Greenstein: f_p <= (1 + |g|) / (4 pi (1 - |g|)^2),
-//     its value in the forward (g > 0) or backward peak, over every medium of a
-//     node spanning several. A proven bound, loose for strong g.
+//   - f_p <= 1/(4 pi) (isotropic). Henyey-Greenstein: f_p is monotone in the
+//     cosine between the VRL direction d and v -> x. The node's VRL directions lie
+//     in its DirectionCone (a, alpha) (direction_cone.h); the directions from its
+//     box (half diagonal R, centre c) to x lie within beta = asin(R / |x - c|) of
+//     x - c (every direction when x is within R of c). So that angle lies in
+//     [theta(a, x - c) -+ (alpha + beta)], and f_p is bounded by its value at the
+//     nearer end (PhaseFunction::valueRange, with its float margins), over every
+//     medium of a node spanning several; the angles widen by 2 slack / d + 1e-6
+//     for rounded sample points. Without cones (a cone of pi) this is HG's peak
+//     (1 + |g|) / (4 pi (1 - |g|)^2).
 //   - T_r(v, x) V <= T_r(d) when the node's VRLs lie in x's own medium and its
 //     boundary is convex (the segment x-v stays inside it), else 1.
 //   - sigma_s: the node's medium's, or the largest of all media.
@@ -36,9 +43,12 @@
 #pragma once
 
 #include "render/lightcuts/cut_settings.h"
+#include "render/lightcuts/direction_cone.h"
 #include "render/lightcuts/leaf_segments.h"
 #include "render/lightcuts/light_tree.h"
 #include "render/vrl/camera_segment.h"
+
+#include <memory>
 
 namespace vrl {
 
@@ -46,7 +56,9 @@ class Scene;
 
 class SurfaceClusterBound {
 public:
-    SurfaceClusterBound(const Scene& scene, const LightTree& tree, ClusterBoundSettings settings = {});
+    // `cones`: shared DirectionCones of the tree (built here when the scene has an HG medium and none are given).
+    SurfaceClusterBound(const Scene& scene, const LightTree& tree, ClusterBoundSettings settings = {},
+                        const DirectionCones* cones = nullptr);
 
     // RGB bound for `node` lighting `x`; +infinity (and *xInsideNode = true) when
     // x lies in the node's box (or on one of a small node's segments).
@@ -57,12 +69,17 @@ public:
     static bool provenFor(const Bsdf& bsdf);
 
 private:
+    // The bound on f_p (see above) for the node's VRLs lighting x at distance >= d.
+    double phaseBound(int32_t node, const Vec3& x, double slack, double d) const;
+
     const Scene& scene_;
     const LightTree& tree_;
     ClusterBoundSettings settings_;
     Rgb maxSigmaS_{0.0f};   // over all media: for nodes spanning several
     float maxPhase_ = 0.0f;  // largest phase-function value of any medium
     LeafSegments leaves_;
+    const DirectionCones* cones_ = nullptr;  // with an HG medium: the tree's cones (shared or owned)
+    std::unique_ptr<DirectionCones> ownedCones_;
 };
 
 }  // namespace vrl

@@ -22,7 +22,9 @@ inline Rng vrlStream(uint64_t streamKey, uint32_t vrlIndex) { return Rng(streamK
 
 class LightcutsEstimator {
 public:
-    LightcutsEstimator(const Scene& scene, const LightTree& tree, const VrlEstimator& estimator, CutSettings settings);
+    // `cones`: the tree's DirectionCones, shared with the surface cut (optional).
+    LightcutsEstimator(const Scene& scene, const LightTree& tree, const VrlEstimator& estimator, CutSettings settings,
+                       const DirectionCones* cones = nullptr);
 
     // Multiple scattering from every VRL of the tree along `segment`. The sample of
     // VRL k comes from the stream (streamKey, k) (see vrlStream), as in plain VRL

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <stdexcept>
 #include <string>
 
@@ -13,6 +14,18 @@ PhaseFunction PhaseFunction::henyeyGreenstein(float g) {
     // Below this the density differs from isotropic by < 3e-6 relative, and the
     // inverse CDF would lose its precision to cancellation: treat as isotropic.
     return PhaseFunction(std::abs(g) < kIsotropicBelow ? 0.0f : g);
+}
+
+PhaseFunction::ValueRange PhaseFunction::valueRange(double cosLow, double cosHigh) const {
+    if (g_ == 0.0f) return {double(kInv4Pi), double(kInv4Pi)};  // evalCosine's value
+    const double g = g_;
+    const double numerator = (1.0 - g * g) / (4.0 * 3.14159265358979323846);
+    const double cosNear = g > 0.0 ? cosHigh : cosLow, cosFar = g > 0.0 ? cosLow : cosHigh;
+    const double near = 1.0 + g * g - 2.0 * g * cosNear - kDenominatorSlack;
+    const double far = 1.0 + g * g - 2.0 * g * cosFar + kDenominatorSlack;
+    const double high =
+        near > 0.0 ? numerator / (near * std::sqrt(near)) * (1.0 + 1e-5) : std::numeric_limits<double>::infinity();
+    return {numerator / (far * std::sqrt(far)) * (1.0 - 1e-5), high};
 }
 
 float PhaseFunction::sampleCosine(float u) const {

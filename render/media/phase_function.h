@@ -35,6 +35,26 @@ public:
         return kInv4Pi * (1.0f - g_ * g_) / (denom * std::sqrt(denom));
     }
     float eval(const Vec3& dirIn, const Vec3& dirOut) const { return evalCosine(dirIn.dot(dirOut)); }
+
+    // For the cluster bounds (lightcuts/): bounds, in double, of what evalCosine
+    // returns in float for cosines in [cosLow, cosHigh]. HG is monotone in the
+    // cosine (increasing for g > 0), so the extremes sit at the ends; the float
+    // denominator 1 + g^2 - 2 g cos, off by a few 1e-7, is widened by
+    // kDenominatorSlack either way, the numerator by 1e-5. `high` is +infinity
+    // when the slack reaches (1 - |g|)^2 (|g| > 0.9985 near the peak).
+    struct ValueRange {
+        double low, high;
+    };
+    static constexpr double kDenominatorSlack = 2e-6;
+    ValueRange valueRange(double cosLow, double cosHigh) const;
+    // The largest |d ln f / d theta| over all angles theta: 3|g| / (1 - g^2), at
+    // cos theta = 2g / (1 + g^2).
+    double logSlopeBound() const { return 3.0 * std::abs(double(g_)) / (1.0 - double(g_) * double(g_)); }
+    // 1 + the relative error of a float value whose denominator is off by kDenominatorSlack.
+    double floatErrorFactor() const {
+        const double q = 1.0 - std::abs(double(g_));
+        return 1.0 + 3.0 * kDenominatorSlack / (q * q);
+    }
     // Samples dirOut given dirIn from two uniform numbers in [0,1).
     PhaseSample sample(const Vec3& dirIn, const Vec2& u) const;
     // Samples the cosine alone (the azimuth is uniform).

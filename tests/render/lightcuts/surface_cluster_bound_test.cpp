@@ -6,7 +6,8 @@
 // cluster flux, VrlSurfaceEstimator(scene, 1)). For diffuse and smooth-plastic
 // surfaces the bound is proven (header), so zero violations are required over
 // more than 10^6 (node, point, sample) triples in grey, chromatic and
-// Henyey-Greenstein (g = 0.7) media, unbounded and in a convex box (where the
+// Henyey-Greenstein (g = 0.7, -0.9, 0.95; the phase bounded over cones of
+// directions) media, unbounded and in a convex box (where the
 // bound uses T_r(d)). The trees include degenerate VRLs: zero length, ending on
 // the surface (x inside or touching a node), and tangent to it. For glossy
 // surfaces (roughconductor, roughplastic) the bound is a heuristic: the
@@ -139,7 +140,9 @@ Tally checkBound(const Scene& scene, uint64_t seed, int vrlCount, int points) {
 
 const Medium kMedia[] = {{"grey", Rgb(0.8f), Rgb(0.2f), 0.0f},
                          {"chromatic", Rgb(0.4f, 0.8f, 1.4f), Rgb(0.2f, 0.1f, 0.05f), 0.0f},
-                         {"hg0.7", Rgb(0.8f), Rgb(0.2f), 0.7f}};
+                         {"hg0.7", Rgb(0.8f), Rgb(0.2f), 0.7f},
+                         {"hg-0.9", Rgb(0.8f), Rgb(0.2f), -0.9f},
+                         {"hg0.95", Rgb(0.4f, 0.8f, 1.4f), Rgb(0.2f), 0.95f}};
 
 TEST(SurfaceClusterBound, NeverExceededForDiffuseAndSmoothPlastic) {
     BsdfDescription plastic;
