@@ -181,6 +181,7 @@ int main(int argc, char** argv) {
     bool buildOnlyMode = false, verbose = false, hgCompare = false;
     std::vector<float> errors = {0.005f, 0.01f, 0.02f, 0.05f, 0.1f, 0.2f, 0.5f, 1.0f, 2.0f};
     float hgEpsilon = 1.0f;
+    float sphereBeyond = 0.0f;
     app.add_option("--scene", scenePath, "Scene file (default scenes/smoke-room.xml)");
     app.add_option("-D,--define", defines, "Override a scene <default>: -D name=value (repeatable)");
     app.add_option("--vrls", counts, "VRL counts to run (default 10000 100000 1000000)");
@@ -198,6 +199,9 @@ int main(int argc, char** argv) {
     app.add_option("--hg-epsilon", hgEpsilon,
                    "--hg-compare: the heuristic's epsilon (default 1); otherwise, given: the cuts bound HG media by "
                    "this heuristic instead of the proven bound (as builds before the proven bound did)");
+    app.add_option("--sphere-beyond", sphereBeyond,
+                   "Nodes above the exact-distance size take h_min from their bounding sphere when it is beyond this "
+                   "many radii (default 0: always the box)");
     app.add_flag("-v,--verbose", verbose, "Log the light tree build's phases (spdlog debug)");
     CLI11_PARSE(app, argc, argv);
     const bool surfacePart = part == "medium-surface";
@@ -242,6 +246,7 @@ int main(int argc, char** argv) {
     }
     ClusterBoundSettings bound;
     if (app.count("--hg-epsilon") > 0) bound.hgBound = HgBound::Epsilon, bound.anisotropyEpsilon = hgEpsilon;
+    bound.sphereDistanceBeyond = sphereBeyond;
     std::printf("scene %s%s, %dx%d, error threshold %.3f, part %s only\n", scenePath.c_str(), defined.c_str(), w, h,
                 error, surfacePart ? "(c) medium-to-surface" : "(d) medium-to-medium");
     if (bound.hgBound == HgBound::Epsilon)

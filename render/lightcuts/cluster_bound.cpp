@@ -123,8 +123,17 @@ double ClusterBound::phaseFactor(int32_t index, const CameraSegment& segment, do
 
 double ClusterBound::minimumDistance(int32_t index, const CameraSegment& segment) const {
     const LightTreeNode& node = tree_.nodes()[index];
-    if (node.vrlCount > settings_.exactDistanceBelow)
+    if (node.vrlCount > settings_.exactDistanceBelow) {
+        if (settings_.sphereDistanceBeyond > 0.0f) {
+            // The bounding sphere's distance is a lower bound of the box's, close to it far away.
+            const Imath::V3d centre = (Imath::V3d(node.box.min) + Imath::V3d(node.box.max)) * 0.5;
+            const double radius = 0.5 * (Imath::V3d(node.box.max) - Imath::V3d(node.box.min)).length();
+            const Imath::V3d omega = Imath::V3d(segment.direction).normalized(), r = centre - Imath::V3d(segment.origin);
+            const double sphere = (r - omega * omega.dot(r)).length() - radius;
+            if (sphere > double(settings_.sphereDistanceBeyond) * radius) return sphere;
+        }
         return distanceLineBox(segment.origin, segment.direction, node.box);
+    }
     // Small node: the exact distance from its VRL segments (a contiguous range).
     double best = std::numeric_limits<double>::infinity();
     const auto starts = leaves_.starts(index), ends = leaves_.ends(index);

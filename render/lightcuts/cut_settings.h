@@ -15,6 +15,9 @@ enum class HgBound : uint8_t {
 
 struct ClusterBoundSettings {
     uint32_t exactDistanceBelow = 32;  // VRL nodes with at most this many VRLs: h_min from their segments
+    // Larger VRL nodes: h_min from the box's bounding sphere (one distance) when that is
+    // beyond this many radii, else from the box (a slab test and 12 edges); 0: always the box.
+    float sphereDistanceBeyond = 0.0f;
     HgBound hgBound = HgBound::Cones;  // VRL cuts; VPL cuts always use the epsilon heuristic
     float anisotropyEpsilon = 1.0f;    // HgBound::Epsilon and VPL cuts: bound x (1 + epsilon)
     float glossyMargin = 2.0f;         // VRL-lit glossy surfaces: f|cos| towards the box's corners x this

@@ -607,6 +607,45 @@ TEST(ClusterBound, BoundsIsotropicEstimateWithBoxDistancesOnly) {
     expectNoViolation(r);
 }
 
+// Sphere distances for large nodes (sphereDistanceBeyond = 2: the bounding sphere's
+// distance when it is beyond two radii, a lower bound of the box's): still a bound
+// (seed 123, 300 trees with up to 200 VRLs, so that nodes above the exact-distance
+// size exist, ~1e6 triples).
+TEST(ClusterBound, BoundsIsotropicEstimateWithSphereDistances) {
+    const auto scene = unboundedScene(Rgb(0.7f, 0.4f, 0.1f), Rgb(0.2f), 0.0f);
+    SamplingPlan plan;
+    plan.seed = 123;
+    plan.trees = 300;
+    plan.minVrls = 100, plan.maxVrls = 200;
+    plan.settings.sphereDistanceBeyond = 2.0f;
+    const BoundCheck r = checkBound(*scene, plan);
+    print("isotropic, unbounded, sphere distances beyond 2 radii", r);
+    EXPECT_GE(r.triples, 300'000u);
+    expectNoViolation(r);
+    // The sphere path is taken: far from a 150-VRL tree, large nodes get a distance
+    // below the box's (never above it), small ones the same.
+    Rng rng(124, 0);
+    const Region region;
+    const ReferenceLine line = randomReferenceLine(rng, region);
+    std::vector<Vrl> vrls;
+    for (int i = 0; i < 150; ++i) vrls.push_back(randomVrl(rng, region, line, 0));
+    const LightTree tree = LightTree::build(vrls);
+    const ClusterBound box(*scene, tree), sphere(*scene, tree, plan.settings);
+    CameraSegment far;
+    far.origin = Vec3(-30.0f, 20.0f, 25.0f);
+    far.direction = Vec3(1.0f, 0.0f, 0.0f);
+    far.length = 60.0f;
+    far.medium = 0;
+    int below = 0;
+    for (size_t n = 0; n < tree.nodes().size(); ++n) {
+        const double b = box.minimumDistance(int32_t(n), far), s = sphere.minimumDistance(int32_t(n), far);
+        EXPECT_LE(s, b * (1.0 + 1e-9)) << "node " << n;
+        if (tree.nodes()[n].vrlCount <= plan.settings.exactDistanceBelow) EXPECT_EQ(s, b);
+        below += s < b;
+    }
+    EXPECT_GT(below, 0) << "no node took the sphere distance";
+}
+
 // Convex null-bounded cube [-1,1]^3 (mediumOnlyCube), VRLs and camera segments clipped
 // to its inside (seed 104, 800 trees, ~1e6 triples).
 TEST(ClusterBound, BoundsIsotropicEstimateInConvexCube) {
