@@ -15,7 +15,9 @@
 // where Phi_C L_rep, the node's flux x length, is tighter than Eq. 11's Phi_C L_max
 // (the representative carries the estimate) and also bounds the node's true
 // contribution; h_min <= distance between the node's VRLs and the camera line
-// (less a few float steps, for the rounding of sample points), T_r(h_min)
+// (their box's, their segments' for small nodes, or optionally their bounding
+// sphere's when it is far: ClusterBoundSettings::sphereDistanceBeyond; less a
+// few float steps, for the rounding of sample points), T_r(h_min)
 // only for media whose boundary is convex (else 1), visibility and T_r(u)
 // bounded by 1. A line through the node's box (h_min = 0) gives an infinite
 // bound: the node is always refined.
