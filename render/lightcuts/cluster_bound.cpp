@@ -16,13 +16,17 @@ namespace {
 // Float noise in the estimator's own arithmetic (rounded sample points): the bound
 // carries this relative margin.
 constexpr double kRoundingMargin = 1.001;
-constexpr double kPiD = 3.14159265358979323846;
 
 using V3d = Imath::V3d;
 V3d toD(const Vec3& v) { return {v.x, v.y, v.z}; }
 
-struct AngleRange {
-    double low, high;  // in [0, pi]
+// An angle in [0, pi] as its cosine and (non-negative) sine.
+struct Angle {
+    double c, s;
+    static Angle ofCosine(double c) { return {c, std::sqrt(std::max(0.0, 1.0 - c * c))}; }
+    // The angle of this minus / plus `o` (the caller keeps the result in [0, pi]).
+    Angle minus(const Angle& o) const { return {c * o.c + s * o.s, s * o.c - c * o.s}; }
+    Angle plus(const Angle& o) const { return {c * o.c - s * o.s, s * o.c + c * o.s}; }
 };
 
 // The cosines of the polar angles, from the camera direction omega, of the
@@ -74,15 +78,31 @@ double ClusterBound::hgConeFactor(int32_t index, const CameraSegment& segment, d
     // Polar cosines of toU about omega; the angle at u is pi minus the polar angle.
     const auto [polarLow, polarHigh] = polarCosines(o, omega, double(segment.length), node.box, slack, h);
     const double uLow = std::max(-1.0, -polarHigh - widen), uHigh = std::min(1.0, -polarLow + widen);
-    // The angle at v: within the VRL cone's polar spread of toU's polar angles.
-    const AngleRange polar{std::max(0.0, std::acos(polarHigh) - widen), std::min(kPiD, std::acos(polarLow) + widen)};
-    const double alpha = vrlCone.isSphere() ? kPiD : double(vrlCone.halfAngle);
-    const double thetaA = angleBetween(vrlCone.axis, segment.direction);  // atan2: exact for a float-rounded axis
-    const AngleRange aPolar{std::max(0.0, thetaA - alpha - 1e-7), std::min(kPiD, thetaA + alpha + 1e-7)};
-    const double lowest = aPolar.low + polar.low, highest = aPolar.high + polar.high;
-    const double vAngleLow = std::max({0.0, polar.low - aPolar.high, aPolar.low - polar.high});
-    const double vAngleHigh = highest < kPiD ? highest : lowest > kPiD ? 2.0 * kPiD - lowest : kPiD;
-    const double vLow = std::cos(vAngleHigh), vHigh = std::cos(vAngleLow);
+    // The angle at v: within the VRL cone's polar spread of toU's polar angles. Angles
+    // in [0, pi] are carried as (cos, sin) and combined by the addition formulas; the
+    // rounding widening applies to the cosines (a cosine moves by at most its angle).
+    double vLow = -1.0, vHigh = 1.0;
+    if (!vrlCone.isSphere()) {
+        const Angle theta1 = Angle::ofCosine(polarHigh), theta2 = Angle::ofCosine(polarLow);
+        const V3d a = toD(vrlCone.axis).normalized();
+        const Angle thetaA{a.dot(omega), a.cross(omega).length()};
+        const Angle alpha{std::cos(double(vrlCone.halfAngle)), std::sin(double(vrlCone.halfAngle))};
+        // The VRL directions' polar angles: [max(0, thetaA - alpha), min(pi, thetaA + alpha)].
+        const Angle aLow = thetaA.c >= alpha.c ? Angle{1.0, 0.0} : thetaA.minus(alpha);
+        const Angle aHigh = thetaA.c <= -alpha.c ? Angle{-1.0, 0.0} : thetaA.plus(alpha);
+        // Smallest angle: the gap between the two polar intervals (at most one is positive).
+        if (theta1.c < aHigh.c)
+            vHigh = theta1.minus(aHigh).c;
+        else if (aLow.c < theta2.c)
+            vHigh = aLow.minus(theta2).c;
+        // Largest: the sum of polar angles, or 2 pi minus it, or pi.
+        if (aHigh.c > -theta2.c)
+            vLow = aHigh.plus(theta2).c;
+        else if (aLow.c < -theta1.c)
+            vLow = aLow.plus(theta1).c;
+        const double margin = widen + 1e-7;
+        vHigh = std::min(1.0, vHigh + margin), vLow = std::max(-1.0, vLow - margin);
+    }
     PhaseFunction::ValueRange fv{kInfinity, 0.0};
     double slope = 0.0, floatFactor = 1.0;
     const auto extend = [&](const HomogeneousMedium& m) {

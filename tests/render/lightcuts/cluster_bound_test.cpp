@@ -640,7 +640,9 @@ TEST(ClusterBound, BoundsIsotropicEstimateWithSphereDistances) {
     for (size_t n = 0; n < tree.nodes().size(); ++n) {
         const double b = box.minimumDistance(int32_t(n), far), s = sphere.minimumDistance(int32_t(n), far);
         EXPECT_LE(s, b * (1.0 + 1e-9)) << "node " << n;
-        if (tree.nodes()[n].vrlCount <= plan.settings.exactDistanceBelow) EXPECT_EQ(s, b);
+        if (tree.nodes()[n].vrlCount <= plan.settings.exactDistanceBelow) {
+            EXPECT_EQ(s, b);
+        }
         below += s < b;
     }
     EXPECT_GT(below, 0) << "no node took the sphere distance";
