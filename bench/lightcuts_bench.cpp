@@ -27,10 +27,13 @@
 #include "render/image/image_metrics.h"
 #include "render/integrators/transport_integrator.h"
 #include "render/lightcuts/light_tree.h"
+#include "render/image/exr_io.h"
 #include "render/lightcuts/vrl_cut.h"
 #include "render/scene/scene.h"
 #include "render/scene_io/mitsuba/mitsuba_parser.h"
 #include "render/vrl/light_tracer.h"
+#include "render/vrl/vrl_kernel.h"
+#include "tests/support/test_scenes.h"
 
 #include <CLI/CLI.hpp>
 #include <spdlog/spdlog.h>
@@ -182,7 +185,9 @@ int main(int argc, char** argv) {
     std::vector<float> errors = {0.005f, 0.01f, 0.02f, 0.05f, 0.1f, 0.2f, 0.5f, 1.0f, 2.0f};
     float hgEpsilon = 1.0f;
     float sphereBeyond = 0.0f;
-    app.add_option("--scene", scenePath, "Scene file (default scenes/smoke-room.xml)");
+    app.add_option("--scene", scenePath,
+                   "Scene file (default scenes/smoke-room.xml), or lit-room / infinite: the tests' lit room with its "
+                   "occluder, a point light in an unbounded medium (-D g=... for HG)");
     app.add_option("-D,--define", defines, "Override a scene <default>: -D name=value (repeatable)");
     app.add_option("--vrls", counts, "VRL counts to run (default 10000 100000 1000000)");
     app.add_option("--resolution", resolution, "Image size WxH for shading (default 64x48)");
@@ -202,6 +207,9 @@ int main(int argc, char** argv) {
     app.add_option("--sphere-beyond", sphereBeyond,
                    "Nodes above the exact-distance size take h_min from their bounding sphere when it is beyond this "
                    "many radii (default 0: always the box)");
+    std::string plainExr;
+    app.add_option("--plain-exr", plainExr,
+                   "Write each N's plain-VRL image to PREFIX-N.exr (to compare builds with `vrl compare`)");
     app.add_flag("-v,--verbose", verbose, "Log the light tree build's phases (spdlog debug)");
     CLI11_PARSE(app, argc, argv);
     const bool surfacePart = part == "medium-surface";
@@ -216,7 +224,17 @@ int main(int argc, char** argv) {
         }
         parseOptions.defines[d.substr(0, eq)] = d.substr(eq + 1);
     }
-    SceneDescription description = parseMitsubaScene(scenePath, parseOptions);
+    // The built-in test scenes (tests/support/test_scenes.h): `lit-room`, the lit room
+    // with its occluder (isotropic, sigma_s 0.4, sigma_a 0.1; -D g=... sets HG), and
+    // `infinite`, a point light in an unbounded medium (no surfaces: no occlusion rays).
+    const auto builtinG = [&] {
+        const auto g = parseOptions.defines.find("g");
+        return g == parseOptions.defines.end() ? 0.0f : std::stof(g->second);
+    };
+    SceneDescription description =
+        scenePath == "lit-room"   ? test::litRoomWithOccluder(Rgb(0.4f), Rgb(0.1f), builtinG())
+        : scenePath == "infinite" ? test::pointLightInInfiniteMedium(Rgb(10.0f), Vec3(0.0f), Rgb(0.4f), Rgb(0.1f), builtinG())
+                                  : parseMitsubaScene(scenePath, parseOptions);
     int w = 0, h = 0;
     if (std::sscanf(resolution.c_str(), "%dx%d", &w, &h) != 2 || w < 1 || h < 1) {
         std::fprintf(stderr, "bad --resolution '%s'\n", resolution.c_str());
@@ -251,6 +269,8 @@ int main(int argc, char** argv) {
                 error, surfacePart ? "(c) medium-to-surface" : "(d) medium-to-medium");
     if (bound.hgBound == HgBound::Epsilon)
         std::printf("HG media: the heuristic bound, isotropic x (1 + %g)\n", double(bound.anisotropyEpsilon));
+    std::printf("VRL kernel: %s lanes; plain_ns, cut_ns: ns per VRL estimate and core (1e9 / that: estimates per second "
+                "and core)\n", vrlKernelTarget());
     std::printf("%9s %8s %9s %8s %9s %10s %9s %9s %8s %9s %8s %8s %8s %9s %8s\n", "VRLs", "trace_s", "build_s", "tree_MB",
                 "global_s", "gatherX", "plain_s", "cuts_s", "speedup", "relRMSE", "#Eval", "#Inter", "cut", "plain_ns",
                 "cut_ns");
@@ -273,6 +293,11 @@ int main(int argc, char** argv) {
             gather = std::to_string(double(cuts.total.evaluated) / std::max(1u, globalCuts.total.evaluated)).substr(0, 5);
         }
         const ImageErrorMetrics m = compareImages(plain.image, cuts.image);
+        if (!plainExr.empty()) {
+            ImageSet set;
+            set.image = plain.image;
+            writeExr(plainExr + "-" + std::to_string(n) + ".exr", set);
+        }
         const double plainNs = plain.seconds * cores * 1e9 / (pixels * double(vrls.vrls.size()));
         const double cutNs = cuts.seconds * cores * 1e9 / std::max(1.0, double(cuts.total.evaluated));
         std::printf("%9zu %8.3f %9.3f %8.1f %9s %10s %9.2f %9.2f %8.1f %9.5f %8.0f %8.0f %8.0f %9.0f %8.0f%s\n",

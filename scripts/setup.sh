@@ -8,6 +8,7 @@ packages=(
   libembree-dev libopenexr-dev libimath-dev
   libtbb-dev libspdlog-dev libfmt-dev libcli11-dev libpugixml-dev libtinyobjloader-dev
   libopenimageio-dev
+  libhwy-dev  # render/vrl/vrl_kernel.cpp: portable SIMD with run-time dispatch
   libgtest-dev libgmock-dev
   libgrpc++-dev libprotobuf-dev protobuf-compiler protobuf-compiler-grpc
   python3 python3-numpy python3-yaml python3-matplotlib openssl iproute2

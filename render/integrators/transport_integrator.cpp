@@ -28,6 +28,9 @@ TransportIntegrator::TransportIntegrator(const Scene& scene, const VrlSet& vrls,
         lightcuts_ = std::make_unique<LightcutsEstimator>(scene, *tree_, estimator_, settings.cut, cones_.get());
         surfaceLightcuts_ =
             std::make_unique<SurfaceLightcutsEstimator>(scene, *tree_, surfaceEstimator_, settings.cut, cones_.get());
+    } else if (settings.transports.has(TransportPart::Multiple)) {
+        // Plain VRLs: every VRL for every segment, in SIMD lanes.
+        plainLanes_ = std::make_unique<VrlLanes>(vrls.vrls, scene);
     }
     if (settings.maxDepth >= 0 && settings.maxDepth < 16 && scene.hasSpecularSurfaces() &&
         (settings.transports.has(TransportPart::Multiple) ||
@@ -135,11 +138,7 @@ TransportIntegrator::VirtualLightParts TransportIntegrator::virtualLightParts(co
         } else if (lightcuts_) {
             parts.multiple += lightcuts_->estimate(segment, streamKey, statistics);
         } else {
-            const auto& vrls = tree_ ? tree_->vrls() : vrls_.vrls;
-            for (uint32_t k = 0; k < vrls.size(); ++k) {
-                Rng vrlRng = vrlStream(streamKey, k);
-                parts.multiple += estimator_.contribution(vrls[k], segment, vrlRng);
-            }
+            parts.multiple += estimator_.sumOverVrls(*plainLanes_, segment, streamKey);
         }
     }
     if (surface && path.surface)

@@ -97,6 +97,7 @@ private:
     TransportIntegratorSettings settings_;
     VolumetricPathTracer tracer_;
     VrlEstimator estimator_;
+    std::unique_ptr<VrlLanes> plainLanes_;  // plain VRLs only
     VrlSurfaceEstimator surfaceEstimator_;
     const LightTree* tree_;
     std::unique_ptr<DirectionCones> cones_;  // vrl-lightcuts with an HG medium: shared by both cuts' bounds

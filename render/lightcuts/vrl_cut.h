@@ -17,9 +17,6 @@
 
 namespace vrl {
 
-// The random stream of VRL `vrlIndex` for the camera segment identified by streamKey.
-inline Rng vrlStream(uint64_t streamKey, uint32_t vrlIndex) { return Rng(streamKey, vrlIndex); }
-
 class LightcutsEstimator {
 public:
     // `cones`: the tree's DirectionCones, shared with the surface cut (optional).

@@ -394,16 +394,23 @@ int Scene::mediumAt(const Vec3& point) const {
     return medium;
 }
 
+bool Scene::visible(const Vec3& from, const Vec3& to) const {
+    const Vec3 d = to - from;
+    const float distance = d.length();
+    if (!(distance > 0.0f)) return true;
+    return !occluded(Ray{from, d / distance, distance * (1.0f - 1e-4f)});
+}
+
 Rgb Scene::transmittance(const Vec3& from, const Vec3& to, int medium) const {
     const Vec3 d = to - from;
     const float distance = d.length();
     if (!(distance > 0.0f)) return Rgb(1.0f);
-    // Stop short of the target so that an area light's own surface does not occlude.
-    Ray ray{from, d / distance, distance * (1.0f - 1e-4f)};
     if (!hasNullSurfaces_) {
-        if (occluded(ray)) return Rgb(0.0f);
+        if (!visible(from, to)) return Rgb(0.0f);
         return medium >= 0 ? media_[medium].transmittance(distance) : Rgb(1.0f);
     }
+    // Stop short of the target so that an area light's own surface does not occlude.
+    Ray ray{from, d / distance, distance * (1.0f - 1e-4f)};
     Rgb result(1.0f);
     float segmentStart = 0.0f;
     // Walk the one ray through null boundaries (bounded against degenerate meshes).

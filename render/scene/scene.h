@@ -77,6 +77,9 @@ public:
     std::optional<SurfaceHit> intersect(const Ray& ray) const;
     // True if any surface blocks the segment (origin, origin + t direction), t < tMax.
     bool occluded(const Ray& ray) const;
+    // No surface between two points (stopping 1e-4 of the distance short of `to`, so
+    // that an area light's own surface does not occlude); null surfaces occlude here.
+    bool visible(const Vec3& from, const Vec3& to) const;
     // Transmittance from `from` (in medium `medium`) to `to`, passing through null
     // boundaries (switching media) and returning zero at any other surface.
     Rgb transmittance(const Vec3& from, const Vec3& to, int medium) const;

@@ -79,29 +79,6 @@ Equiangular equiangular(const Vec3& origin, const Vec3& direction, float length,
     return {delta, h, std::atan2(0.0 - delta, h), std::atan2(double(length) - delta, h)};
 }
 
-// Equiangular sampling of the camera segment from xv in the angle phi measured
-// from the segment's start, phi in [0, span): u - delta = h tan(thetaA + phi).
-// With t_a = tan(thetaA) = -delta / h, the span thetaB - thetaA is one atan2,
-// atan2(L h, h^2 - delta (L - delta)) (the tangent difference formula; its sine
-// part L h > 0 puts it in (0, pi) as the span is), and
-// tan(thetaA + phi) = (t_a + tan phi) / (1 - t_a tan phi), so neither angle is formed:
-// one atan2 and one tan per estimate where two atan2 and a tan were.
-struct EquiangularSpan {
-    double delta, h, span;
-    double offsetAt(double phi) const {  // u - delta
-        const double t = std::tan(phi);
-        return h * (h * t - delta) / (h + delta * t);
-    }
-};
-EquiangularSpan equiangularSpan(const Vec3& origin, const Vec3& direction, float length, const Vec3& point) {
-    const V3d w = toDouble(direction), r = toDouble(point - origin);
-    const double delta = w.dot(r);
-    const double distance = (r - w * delta).length();
-    const double h = std::max(distance, 1e-7 * (1.0 + r.length()));  // as equiangular()
-    const double L = double(length);
-    return {delta, h, std::atan2(L * h, h * h - delta * (L - delta))};
-}
-
 }  // namespace
 
 DistanceSample sampleVrlPoint(const Vrl& vrl, const Vec3& lineOrigin, const Vec3& lineDirection, float xi) {
@@ -146,93 +123,101 @@ float equiangularPdf(const Vec3& origin, const Vec3& direction, float length, co
 VrlEstimator::VrlEstimator(const Scene& scene, int samplesPerVrl)
     : scene_(scene), samplesPerVrl_(std::max(1, samplesPerVrl)) {}
 
-Rgb VrlEstimator::contribution(const Vrl& vrl, const CameraSegment& segment, Rng& rng) const {
-    if (!(vrl.length > 0.0f) || !(segment.length > 0.0f)) return Rgb(0.0f);
-    Rgb sum(0.0f);
-    for (int i = 0; i < samplesPerVrl_; ++i) sum += sampleOnce(vrl, segment, rng);
-    return sum / float(samplesPerVrl_);
+KernelSegment VrlEstimator::kernelSegment(const CameraSegment& segment) const {
+    const HomogeneousMedium& medium = scene_.media()[size_t(segment.medium)];
+    KernelSegment k;
+    const Vec3 perpendicular = Frame::fromNormal(segment.direction).s;
+    for (int i = 0; i < 3; ++i) {
+        k.origin[i] = segment.origin[i];
+        k.direction[i] = segment.direction[i];
+        k.perpendicular[i] = perpendicular[i];
+        k.sigmaT[i] = medium.sigmaT()[i];
+    }
+    // Beyond 100 mean free paths of the least extinct channel that scatters, T(u) < e^-100:
+    // the kernel's segment ends there (the 10^30-long rays of unbounded media).
+    float sigmaMin = kInfinity;
+    for (int i = 0; i < 3; ++i)
+        if (medium.sigmaS()[i] > 0.0f) sigmaMin = std::min(sigmaMin, medium.sigmaT()[i]);
+    k.length = sigmaMin > 0.0f && sigmaMin < kInfinity ? std::min(segment.length, 100.0f / sigmaMin) : segment.length;
+    k.g = medium.phase().g();
+    k.medium = segment.medium;
+    k.closedTransmittance = !scene_.mediumNeedsVisibility(segment.medium);
+    k.visibilityOnly = !k.closedTransmittance && !scene_.hasNullSurfaces();
+    return k;
 }
 
-Rgb VrlEstimator::sampleOnce(const Vrl& vrl, const CameraSegment& segment, Rng& rng) const {
-    const HomogeneousMedium& mediumV = scene_.media()[vrl.medium];
-    const HomogeneousMedium& mediumU = scene_.media()[segment.medium];
-    const DistanceSample vs = sampleVrlPoint(vrl, segment.origin, segment.direction, rng.next());
-    if (!(vs.pdf > 0.0f)) return Rgb(0.0f);
-    const Vec3 xv = vrl.origin + vrl.direction * vs.t;
+Rgb VrlEstimator::finish(const CameraSegment& segment, const KernelOutput& out, size_t k) const {
+    Rgb value(out.r[k], out.g[k], out.b[k]);
+    if (!out.deferred[k] || isBlack(value)) return value;
+    const Vec3 xu = segment.origin + segment.direction * out.u[k], xv(out.vX[k], out.vY[k], out.vZ[k]);
+    if (out.deferred[k] == 2) return scene_.visible(xu, xv) ? value : Rgb(0.0f);
+    return value * scene_.media()[size_t(segment.medium)].transmittance(out.u[k]) *
+           scene_.transmittance(xu, xv, segment.medium);
+}
 
-    // u | v: equiangular from xv, or for anisotropic media a mixture of that with a
-    // piecewise-constant fit of f(u) f(v) over kBins bins of the equiangular angle.
-    const EquiangularSpan e = equiangularSpan(segment.origin, segment.direction, segment.length, xv);
-    const double span = e.span;
-    if (!(span > 0.0)) return Rgb(0.0f);
-    const bool anisotropic = !mediumU.phase().isIsotropic() || !mediumV.phase().isIsotropic();
-    constexpr int kBins = kHgBins;
-    constexpr double kUniformWeight = kHgUniformWeight;
-    std::array<double, kBins> binWeight{};
-    double binTotal = 0.0;
-    if (anisotropic) {
-        // In the plane of the camera line and xv, the direction from xv to u(theta) is
-        // w sin(theta) - e cos(theta), e the unit offset of xv from the line: so
-        // cos to the VRL = sin(theta) (d.w) - cos(theta) (d.e), cos to the camera = -sin(theta).
-        // e in double, orthogonal to w to double precision: a float foot point would tilt
-        // it towards w and scale the bins' cosines (the HG cluster bound relies on them).
-        const Imath::V3d w = Imath::V3d(segment.direction.x, segment.direction.y, segment.direction.z).normalized();
-        const Imath::V3d r(double(xv.x) - segment.origin.x, double(xv.y) - segment.origin.y,
-                           double(xv.z) - segment.origin.z);
-        const Imath::V3d offset = r - w * w.dot(r);
-        const double offsetLength = offset.length();
-        const Vec3 frameS = Frame::fromNormal(segment.direction).s;
-        const Imath::V3d unitOffset = offsetLength > 0.0 ? offset / offsetLength : Imath::V3d(frameS.x, frameS.y, frameS.z);
-        const Imath::V3d d(vrl.direction.x, vrl.direction.y, vrl.direction.z);
-        const double dw = d.dot(w), de = d.dot(unitOffset);
-        const double step = span / kBins;
-        // cos, sin of thetaA + step / 2 (cos thetaA = h / r, sin thetaA = -delta / r), then
-        // rotated by step per bin (one sincos pair); only here, not for isotropic media.
-        const double radius = std::sqrt(e.h * e.h + e.delta * e.delta);
-        const double cosA = e.h / radius, sinA = -e.delta / radius;
-        const double cHalf = std::cos(0.5 * step), sHalf = std::sin(0.5 * step);
-        const double cStep = cHalf * cHalf - sHalf * sHalf, sStep = 2.0 * sHalf * cHalf;
-        double c = cosA * cHalf - sinA * sHalf, s = sinA * cHalf + cosA * sHalf;
-        for (int b = 0; b < kBins; ++b) {
-            binWeight[b] = double(mediumV.phase().evalCosine(float(s * dw - c * de)) * mediumU.phase().evalCosine(float(-s)));
-            binTotal += binWeight[b];
-            const double cNext = c * cStep - s * sStep;
-            s = s * cStep + c * sStep;
-            c = cNext;
+Rgb VrlEstimator::contribution(const Vrl& vrl, const CameraSegment& segment, Rng& rng) const {
+    if (!(vrl.length > 0.0f) || !(segment.length > 0.0f)) return Rgb(0.0f);
+    // One VRL in lane 0 of a padded batch (zero-length VRLs in the others).
+    constexpr size_t P = kKernelPadding;
+    alignas(64) float in[VrlLanes::kArrays][P] = {};
+    alignas(64) int32_t media[P] = {};
+    alignas(64) float xi[4][P] = {};
+    alignas(64) float r[P], g[P], b[P], u[P], vx[P], vy[P], vz[P];
+    alignas(64) int32_t deferred[P];
+    float* arrays[VrlLanes::kArrays];
+    for (int a = 0; a < VrlLanes::kArrays; ++a) arrays[a] = in[a];
+    VrlLanes::write(vrl, scene_, arrays, media, 0);
+    const KernelVrls vrls = VrlLanes::view(arrays, media);
+    const float* const numbers[4] = {xi[0], xi[1], xi[2], xi[3]};
+    const KernelOutput out{r, g, b, u, vx, vy, vz, deferred};
+    const KernelSegment k = kernelSegment(segment);
+    Rgb sum(0.0f);
+    for (int i = 0; i < samplesPerVrl_; ++i) {
+        for (auto& x : xi) x[0] = rng.next();
+        evaluateVrlLanes(k, vrls, numbers, out, 1);
+        sum += finish(segment, out, 0);
+    }
+    return sum * scene_.media()[size_t(segment.medium)].sigmaS() * segment.throughputBefore / float(samplesPerVrl_);
+}
+
+Rgb VrlEstimator::sumOverVrls(const VrlLanes& lanes, const CameraSegment& segment, uint64_t streamKey) const {
+    if (!(segment.length > 0.0f) || lanes.size() == 0) return Rgb(0.0f);
+    constexpr size_t kChunk = 16 * kKernelPadding;
+    alignas(64) float xi[4][kChunk];
+    alignas(64) float r[kChunk], g[kChunk], b[kChunk], u[kChunk], vx[kChunk], vy[kChunk], vz[kChunk];
+    alignas(64) int32_t deferred[kChunk];
+    const float* const numbers[4] = {xi[0], xi[1], xi[2], xi[3]};
+    const KernelOutput out{r, g, b, u, vx, vy, vz, deferred};
+    const KernelSegment k = kernelSegment(segment);
+    double total[3] = {0.0, 0.0, 0.0};
+    std::vector<Rng> streams;  // only for several samples per VRL
+    for (size_t first = 0; first < lanes.size(); first += kChunk) {
+        const size_t count = std::min(kChunk, lanes.size() - first);
+        const KernelVrls vrls = lanes.from(first);
+        if (samplesPerVrl_ == 1) {
+            for (size_t j = 0; j < count; ++j) {
+                Rng rng = vrlStream(streamKey, uint32_t(first + j));
+                for (auto& x : xi) x[j] = rng.next();
+            }
+        } else {
+            streams.clear();
+            for (size_t j = 0; j < count; ++j) streams.push_back(vrlStream(streamKey, uint32_t(first + j)));
+        }
+        for (int i = 0; i < samplesPerVrl_; ++i) {
+            if (samplesPerVrl_ > 1)
+                for (size_t j = 0; j < count; ++j)
+                    for (auto& x : xi) x[j] = streams[j].next();
+            for (size_t j = count; j < (count + kKernelPadding - 1) / kKernelPadding * kKernelPadding; ++j)
+                for (auto& x : xi) x[j] = 0.0f;
+            evaluateVrlLanes(k, vrls, numbers, out, count);
+            for (size_t j = 0; j < count; ++j) {
+                const Rgb value = deferred[j] ? finish(segment, out, j) : Rgb(r[j], g[j], b[j]);
+                total[0] += value.x, total[1] += value.y, total[2] += value.z;
+            }
         }
     }
-    double phi;  // the angle from thetaA
-    if (anisotropic && binTotal > 0.0 && rng.next() >= kUniformWeight) {
-        double target = rng.next() * binTotal;
-        int b = 0;
-        while (b < kBins - 1 && target >= binWeight[b]) target -= binWeight[b++];
-        phi = (b + rng.next()) * span / kBins;
-    } else {
-        phi = rng.next() * span;
-    }
-    phi = std::clamp(phi, 0.0, span);
-    double thetaPdf = 1.0 / span;  // density in the angle
-    if (anisotropic && binTotal > 0.0) {
-        const int b = std::min(kBins - 1, int(phi / span * kBins));
-        thetaPdf = kUniformWeight / span + (1.0 - kUniformWeight) * binWeight[b] / binTotal * kBins / span;
-    }
-    const double u = double(std::clamp(float(e.delta + e.offsetAt(phi)), 0.0f, segment.length));
-    const double uPdf = thetaPdf * e.h / (e.h * e.h + (u - e.delta) * (u - e.delta));
-
-    const Vec3 xu = segment.origin + segment.direction * float(u);
-    const Vec3 d = xu - xv;
-    const float w2 = d.length2();
-    if (!(w2 > 0.0f)) return Rgb(0.0f);
-    const float w = std::sqrt(w2);
-    const Vec3 toU = d / w;
-    const float phase = mediumV.phase().eval(vrl.direction, toU) * mediumU.phase().eval(toU, -segment.direction);
-    // In one medium with nothing to occlude, T(u) T(w) = T(u + w): one exponential.
-    const Rgb transmittance = vrl.medium == segment.medium && !scene_.mediumNeedsVisibility(segment.medium)
-                                  ? mediumU.transmittance(float(u) + w)
-                                  : mediumU.transmittance(float(u)) * scene_.transmittance(xu, xv, segment.medium);
-    if (isBlack(transmittance)) return Rgb(0.0f);
-    const double scale = double(phase) / (double(w2) * double(vs.pdf) * uPdf);
-    return vrl.flux * mediumV.sigmaS() * mediumU.sigmaS() * segment.throughputBefore * transmittance * float(scale);
+    const Rgb sum(float(total[0] / samplesPerVrl_), float(total[1] / samplesPerVrl_), float(total[2] / samplesPerVrl_));
+    return sum * scene_.media()[size_t(segment.medium)].sigmaS() * segment.throughputBefore;
 }
 
 }  // namespace vrl

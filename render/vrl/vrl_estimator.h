@@ -14,6 +14,10 @@
 #include "render/core/rng.h"
 #include "render/vrl/camera_segment.h"
 #include "render/vrl/vrl.h"
+#include "render/vrl/vrl_kernel.h"
+#include "render/vrl/vrl_lanes.h"
+
+#include <cstdint>
 
 namespace vrl {
 
@@ -34,6 +38,11 @@ DistanceSample sampleEquiangular(const Vec3& origin, const Vec3& direction, floa
                                  float xi);
 float equiangularPdf(const Vec3& origin, const Vec3& direction, float length, const Vec3& point, float u);
 
+// The random stream of VRL `vrlIndex` for one camera segment (or surface point)
+// `streamKey`: the same in plain and Lightcuts shading, so the two differ only by
+// the cut's approximation.
+inline Rng vrlStream(uint64_t streamKey, uint32_t vrlIndex) { return Rng(streamKey, vrlIndex); }
+
 class VrlEstimator {
 public:
     // Anisotropic media (either end HG): u's equiangular angle is drawn uniformly
@@ -50,10 +59,19 @@ public:
 
     // One estimate of the VRL's radiance contribution to the segment's origin end
     // (already multiplied by the segment's throughputBefore).
+    // Computed by the SIMD kernel (vrl_kernel.h) in one lane; each sample draws
+    // four numbers from `rng`.
     Rgb contribution(const Vrl& vrl, const CameraSegment& segment, Rng& rng) const;
 
+    // The plain VRL method: the sum of contribution() over every VRL of `lanes`,
+    // VRL k with vrlStream(streamKey, k), evaluated in SIMD lanes (no allocation
+    // unless samplesPerVrl > 1).
+    Rgb sumOverVrls(const VrlLanes& lanes, const CameraSegment& segment, uint64_t streamKey) const;
+
 private:
-    Rgb sampleOnce(const Vrl& vrl, const CameraSegment& segment, Rng& rng) const;
+    KernelSegment kernelSegment(const CameraSegment& segment) const;
+    // Lane k's estimate, with the transmittance of a deferred lane.
+    Rgb finish(const CameraSegment& segment, const KernelOutput& out, size_t k) const;
 
     const Scene& scene_;
     int samplesPerVrl_;
