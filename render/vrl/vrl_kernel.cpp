@@ -48,9 +48,9 @@ HWY_INLINE V AtanOfPositiveY(D d, V y, V x) {
 // VRL origin's distance from the camera line). Float would lose h0 for lines
 // 1e-5 from parallel (the cross product's rounding times |r|) and break the
 // cancellation the cluster bounds rest on. s = 0 marks parallel lines.
-void LinePairLanes(const KernelSegment& seg, const KernelVrls& in, size_t first, size_t lanes, float* sOut,
+template <class DD>
+void LinePairLanes(DD dd, const KernelSegment& seg, const KernelVrls& in, size_t first, size_t lanes, float* sOut,
                    float* v0Out, float* h0Out, float* offsetOut) {
-    const hn::ScalableTag<double> dd;
     const hn::Rebind<float, decltype(dd)> df;
     using VD = hn::Vec<decltype(dd)>;
     const VD wx = hn::Set(dd, seg.direction[0]), wy = hn::Set(dd, seg.direction[1]), wz = hn::Set(dd, seg.direction[2]);
@@ -79,9 +79,11 @@ void LinePairLanes(const KernelSegment& seg, const KernelVrls& in, size_t first,
     }
 }
 
-void EvaluateVrlLanes(const KernelSegment& seg, const KernelVrls& in, const float* const xi[4],
-                      const KernelOutput& out, size_t count) {
-    const hn::ScalableTag<float> d;
+// D: the float lanes (the widest for batches, 4 for one VRL: the same arithmetic
+// per lane); DD: double lanes for the line geometry.
+template <class D, class DD>
+HWY_INLINE void EvaluateLanes(D d, DD dd, const KernelSegment& seg, const KernelVrls& in, const float* const xi[4],
+                              const KernelOutput& out, size_t count) {
     const hn::RebindToSigned<decltype(d)> di;
     using V = hn::Vec<decltype(d)>;
     const size_t lanes = hn::Lanes(d);
@@ -109,7 +111,7 @@ void EvaluateVrlLanes(const KernelSegment& seg, const KernelVrls& in, const floa
         // The lines' geometry in double (LinePairLanes): s, v0, h0, |r_perp|.
         alignas(64) float pairS[kKernelPadding], pairV0[kKernelPadding], pairH0[kKernelPadding],
             pairOffset[kKernelPadding];
-        LinePairLanes(seg, in, i, lanes, pairS, pairV0, pairH0, pairOffset);
+        LinePairLanes(dd, seg, in, i, lanes, pairS, pairV0, pairH0, pairOffset);
         const V s = hn::Load(d, pairS), v0 = hn::Load(d, pairV0), h0 = hn::Load(d, pairH0);
         const auto notParallel = hn::Gt(s, zero);
         const V sSafe = hn::IfThenElse(notParallel, s, one);
@@ -262,6 +264,15 @@ void EvaluateVrlLanes(const KernelSegment& seg, const KernelVrls& in, const floa
         hn::StoreU(hn::IfThenElse(deferT, hn::Set(di, 1), hn::IfThenElseZero(deferVisibility, hn::Set(di, seg.visibilityOnly ? 2 : 0))),
                    di, out.deferred + i);
     }
+}
+
+void EvaluateVrlLanes(const KernelSegment& seg, const KernelVrls& in, const float* const xi[4],
+                      const KernelOutput& out, size_t count) {
+    if (count <= 4) {  // one VRL (the cuts): four lanes waste less than sixteen
+        EvaluateLanes(hn::CappedTag<float, 4>(), hn::CappedTag<double, 2>(), seg, in, xi, out, count);
+        return;
+    }
+    EvaluateLanes(hn::ScalableTag<float>(), hn::ScalableTag<double>(), seg, in, xi, out, count);
 }
 
 }  // namespace HWY_NAMESPACE
