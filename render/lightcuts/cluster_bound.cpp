@@ -155,11 +155,7 @@ double ClusterBound::minimumDistance(int32_t index, const CameraSegment& segment
         return distanceLineBox(segment.origin, segment.direction, node.box);
     }
     // Small node: the exact distance from its VRL segments (a contiguous range).
-    double best = std::numeric_limits<double>::infinity();
-    const auto starts = leaves_.starts(index), ends = leaves_.ends(index);
-    for (size_t k = 0; k < starts.size(); ++k)
-        best = std::min(best, distanceLineSegment(segment.origin, segment.direction, starts[k], ends[k]));
-    return best;
+    return leaves_.minDistanceToLine(index, segment.origin, segment.direction);
 }
 
 Rgb ClusterBound::bound(int32_t index, const CameraSegment& segment, bool* lineCrossesNode) const {

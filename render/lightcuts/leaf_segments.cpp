@@ -1,5 +1,7 @@
 #include "render/lightcuts/leaf_segments.h"
 
+#include "render/lightcuts/segment_distances.h"
+
 #include <utility>
 
 namespace vrl {
@@ -31,6 +33,19 @@ LeafSegments::LeafSegments(const LightTree& tree) : tree_(tree) {
             first_[i] = first_[nodes[i].left];
         }
     }
+    for (auto& lane : lanes_) lane.assign(start_.size() + kSegmentLanesPadding, 0.0f);
+    for (size_t k = 0; k < start_.size(); ++k)
+        for (int axis = 0; axis < 3; ++axis) {
+            lanes_[axis][k] = start_[k][axis];
+            lanes_[3 + axis][k] = end_[k][axis];
+        }
+}
+
+double LeafSegments::minDistanceToLine(int32_t node, const Vec3& origin, const Vec3& direction) const {
+    const size_t first = first_[node];
+    const SegmentLanes lanes{lanes_[0].data() + first, lanes_[1].data() + first, lanes_[2].data() + first,
+                             lanes_[3].data() + first, lanes_[4].data() + first, lanes_[5].data() + first};
+    return minDistanceLineSegments(origin, direction, lanes, count(node));
 }
 
 }  // namespace vrl

@@ -3,6 +3,8 @@
 #include "render/lightcuts/cut_walk.h"
 #include "render/scene/scene.h"
 
+#include <algorithm>
+
 namespace vrl {
 
 LightcutsEstimator::LightcutsEstimator(const Scene& scene, const LightTree& tree, const VrlEstimator& estimator,
@@ -31,6 +33,19 @@ Rgb LightcutsEstimator::estimate(const CameraSegment& segment, uint64_t streamKe
             representative.flux = node.clusterFlux;
             Rng rng = vrlStream(streamKey, node.representative);
             return self.estimator_.contribution(representative, segment, rng);
+        }
+        // leaf() and estimate() of several nodes in the kernel's lanes.
+        void evaluate(const int32_t* ids, Rgb* out, size_t count) const {
+            VrlEstimator::Query queries[kKernelPadding];
+            for (size_t first = 0; first < count; first += kKernelPadding) {
+                const size_t n = std::min(kKernelPadding, count - first);
+                for (size_t j = 0; j < n; ++j) {
+                    const LightTreeNode& node = self.tree_.nodes()[ids[first + j]];
+                    const Vrl& vrl = self.tree_.vrls()[node.representative];
+                    queries[j] = {&vrl, node.isLeaf() ? vrl.flux : node.clusterFlux, node.representative};
+                }
+                self.estimator_.contributions(queries, n, segment, streamKey, out + first);
+            }
         }
     };
     return walkCut(tree_, settings_, statistics, Visitor{*this, segment, streamKey});

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <optional>
 
 namespace vrl {
 
@@ -178,6 +179,46 @@ Rgb VrlEstimator::contribution(const Vrl& vrl, const CameraSegment& segment, Rng
         sum += finish(segment, out, 0);
     }
     return sum * scene_.media()[size_t(segment.medium)].sigmaS() * segment.throughputBefore / float(samplesPerVrl_);
+}
+
+void VrlEstimator::contributions(const Query* queries, size_t count, const CameraSegment& segment, uint64_t streamKey,
+                                 Rgb* result) const {
+    if (!(segment.length > 0.0f)) {
+        std::fill(result, result + count, Rgb(0.0f));
+        return;
+    }
+    constexpr size_t P = kKernelPadding;
+    alignas(64) float in[VrlLanes::kArrays][P] = {};
+    alignas(64) int32_t media[P] = {};
+    alignas(64) float xi[4][P] = {};
+    alignas(64) float r[P], g[P], b[P], u[P], vx[P], vy[P], vz[P];
+    alignas(64) int32_t deferred[P];
+    float* arrays[VrlLanes::kArrays];
+    for (int a = 0; a < VrlLanes::kArrays; ++a) arrays[a] = in[a];
+    const KernelVrls vrls = VrlLanes::view(arrays, media);
+    const float* const numbers[4] = {xi[0], xi[1], xi[2], xi[3]};
+    const KernelOutput out{r, g, b, u, vx, vy, vz, deferred};
+    const KernelSegment k = kernelSegment(segment);
+    const Rgb after = scene_.media()[size_t(segment.medium)].sigmaS() * segment.throughputBefore / float(samplesPerVrl_);
+    for (size_t first = 0; first < count; first += P) {
+        const size_t n = std::min(P, count - first);
+        std::optional<Rng> streams[P];
+        for (size_t j = 0; j < n; ++j) {
+            Vrl vrl = *queries[first + j].vrl;
+            vrl.flux = queries[first + j].flux;
+            VrlLanes::write(vrl, scene_, arrays, media, j);
+            streams[j].emplace(vrlStream(streamKey, queries[first + j].stream));
+        }
+        for (size_t j = n; j < P; ++j) in[VrlLanes::kLength][j] = 0.0f;  // padding: nothing
+        Rgb sum[P];
+        for (int i = 0; i < samplesPerVrl_; ++i) {
+            for (size_t j = 0; j < n; ++j)
+                for (auto& x : xi) x[j] = streams[j]->next();
+            evaluateVrlLanes(k, vrls, numbers, out, n);
+            for (size_t j = 0; j < n; ++j) sum[j] = i == 0 ? finish(segment, out, j) : sum[j] + finish(segment, out, j);
+        }
+        for (size_t j = 0; j < n; ++j) result[first + j] = sum[j] * after;
+    }
 }
 
 Rgb VrlEstimator::sumOverVrls(const VrlLanes& lanes, const CameraSegment& segment, uint64_t streamKey) const {

@@ -63,6 +63,17 @@ public:
     // four numbers from `rng`.
     Rgb contribution(const Vrl& vrl, const CameraSegment& segment, Rng& rng) const;
 
+    // Several contributions at once in SIMD lanes (the cuts' nodes): query k is
+    // contribution(*vrl, segment, rng) with vrl's flux replaced by `flux` and rng =
+    // vrlStream(streamKey, stream), written to out[k].
+    struct Query {
+        const Vrl* vrl;
+        Rgb flux;
+        uint32_t stream;
+    };
+    void contributions(const Query* queries, size_t count, const CameraSegment& segment, uint64_t streamKey,
+                       Rgb* out) const;
+
     // The plain VRL method: the sum of contribution() over every VRL of `lanes`,
     // VRL k with vrlStream(streamKey, k), evaluated in SIMD lanes (no allocation
     // unless samplesPerVrl > 1).

@@ -1,0 +1,69 @@
+// Line-to-segments distances in double lanes (contract: segment_distances.h).
+
+#undef HWY_TARGET_INCLUDE
+#define HWY_TARGET_INCLUDE "render/lightcuts/segment_distances.cpp"
+#include <hwy/foreach_target.h>  // IWYU pragma: keep
+
+#include <hwy/highway.h>
+
+#include "render/lightcuts/segment_distances.h"
+
+#include <limits>
+
+HWY_BEFORE_NAMESPACE();
+namespace vrl {
+namespace HWY_NAMESPACE {
+namespace hn = hwy::HWY_NAMESPACE;
+
+// Imath's dot product order: (x x' + y y') + z z'.
+template <class V>
+HWY_INLINE V Dot3(V ax, V ay, V az, V bx, V by, V bz) {
+    return hn::Add(hn::Add(hn::Mul(ax, bx), hn::Mul(ay, by)), hn::Mul(az, bz));
+}
+
+double MinDistanceLineSegments(const Vec3& origin, const Vec3& direction, const SegmentLanes& s, size_t count) {
+    const hn::ScalableTag<double> dd;
+    const hn::Rebind<float, decltype(dd)> df;
+    using V = hn::Vec<decltype(dd)>;
+    const V dx = hn::Set(dd, double(direction.x)), dy = hn::Set(dd, double(direction.y)), dz = hn::Set(dd, double(direction.z));
+    const V ox = hn::Set(dd, double(origin.x)), oy = hn::Set(dd, double(origin.y)), oz = hn::Set(dd, double(origin.z));
+    const V zero = hn::Zero(dd), one = hn::Set(dd, 1.0);
+    V best = hn::Set(dd, std::numeric_limits<double>::infinity());
+    const size_t lanes = hn::Lanes(dd);
+    for (size_t i = 0; i < count; i += lanes) {
+        const auto load = [&](const float* p) { return hn::PromoteTo(dd, hn::LoadU(df, p + i)); };
+        const V ax = load(s.ax), ay = load(s.ay), az = load(s.az);
+        // distanceLineSegment: ra = a - origin, ab = b - a, p and q their parts across the line.
+        const V rax = hn::Sub(ax, ox), ray = hn::Sub(ay, oy), raz = hn::Sub(az, oz);
+        const V abx = hn::Sub(load(s.bx), ax), aby = hn::Sub(load(s.by), ay), abz = hn::Sub(load(s.bz), az);
+        const V dra = Dot3(dx, dy, dz, rax, ray, raz), dab = Dot3(dx, dy, dz, abx, aby, abz);
+        const V px = hn::Sub(rax, hn::Mul(dx, dra)), py = hn::Sub(ray, hn::Mul(dy, dra)), pz = hn::Sub(raz, hn::Mul(dz, dra));
+        const V qx = hn::Sub(abx, hn::Mul(dx, dab)), qy = hn::Sub(aby, hn::Mul(dy, dab)), qz = hn::Sub(abz, hn::Mul(dz, dab));
+        const V qq = Dot3(qx, qy, qz, qx, qy, qz);
+        const auto degenerate = hn::Le(qq, zero);
+        const V t = hn::Div(hn::Neg(Dot3(px, py, pz, qx, qy, qz)), hn::IfThenElse(degenerate, one, qq));
+        const V sClamped = hn::IfThenZeroElse(degenerate, hn::Min(hn::Max(t, zero), one));
+        const V cx = hn::Add(px, hn::Mul(qx, sClamped)), cy = hn::Add(py, hn::Mul(qy, sClamped)),
+                cz = hn::Add(pz, hn::Mul(qz, sClamped));
+        const V distance = hn::Sqrt(Dot3(cx, cy, cz, cx, cy, cz));
+        const auto inRange = hn::FirstN(dd, count - i);
+        best = hn::IfThenElse(inRange, hn::Min(best, distance), best);
+    }
+    return hn::GetLane(hn::MinOfLanes(dd, best));
+}
+
+}  // namespace HWY_NAMESPACE
+}  // namespace vrl
+HWY_AFTER_NAMESPACE();
+
+#if HWY_ONCE
+namespace vrl {
+
+HWY_EXPORT(MinDistanceLineSegments);
+
+double minDistanceLineSegments(const Vec3& origin, const Vec3& direction, const SegmentLanes& segments, size_t count) {
+    return HWY_DYNAMIC_DISPATCH(MinDistanceLineSegments)(origin, direction, segments, count);
+}
+
+}  // namespace vrl
+#endif
