@@ -1,5 +1,7 @@
 #include "render/core/distance.h"
 
+#include "render/core/segment_distances.h"
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -43,21 +45,24 @@ double distanceLineBox(const Vec3& origin, const Vec3& direction, const Imath::B
         }
     }
     if (crosses) return 0.0;
-    // Otherwise the distance, a convex function over the box, is smallest on an edge.
-    double best = std::numeric_limits<double>::infinity();
+    // Otherwise the distance, a convex function over the box, is smallest on an edge:
+    // the 12 edges in SIMD lanes (distanceLineSegment's arithmetic, bit for bit).
+    constexpr size_t kEdges = 12, kSize = kEdges + kSegmentLanesPadding;
+    float ends[6][kSize] = {};
     const Vec3 lo = box.min, hi = box.max;
+    size_t edge = 0;
     for (int axis = 0; axis < 3; ++axis) {
         const int u = (axis + 1) % 3, v = (axis + 2) % 3;
-        for (int corner = 0; corner < 4; ++corner) {
+        for (int corner = 0; corner < 4; ++corner, ++edge) {
             Vec3 a, b;
             a[u] = b[u] = (corner & 1) ? hi[u] : lo[u];
             a[v] = b[v] = (corner & 2) ? hi[v] : lo[v];
             a[axis] = lo[axis];
             b[axis] = hi[axis];
-            best = std::min(best, distanceLineSegment(origin, direction, a, b));
+            for (int k = 0; k < 3; ++k) ends[k][edge] = a[k], ends[3 + k][edge] = b[k];
         }
     }
-    return best;
+    return minDistanceLineSegments(origin, direction, {ends[0], ends[1], ends[2], ends[3], ends[4], ends[5]}, kEdges);
 }
 
 double distancePointBox(const Vec3& point, const Imath::Box3f& box) {

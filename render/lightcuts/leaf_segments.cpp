@@ -1,6 +1,6 @@
 #include "render/lightcuts/leaf_segments.h"
 
-#include "render/lightcuts/segment_distances.h"
+#include "render/core/segment_distances.h"
 
 #include <utility>
 

@@ -48,14 +48,19 @@ double VrlImportance::segment(int32_t index, const CameraSegment& segment) const
                      std::abs(double(segment.direction.z)) * half.z;
     const double S = double(segment.length);
     const double t = std::clamp(0.5 * S, tc - r, tc + r);
-    const double thetaB = std::atan((S - t) / h), thetaA = -std::atan(t / h);
-    const double angle = thetaB - thetaA;
+    // The angle thetaB - thetaA = atan(b) + atan(a), a = t / h, b = (S - t) / h, is
+    // atan2(a + b, 1 - a b) (a + b = S / h > 0: in (0, pi)), and the tangent of its
+    // middle direction, tan((thetaA + thetaB) / 2) = tan((atan b - atan a) / 2), is
+    // (b - a) / (sqrt((1 + a^2)(1 + b^2)) + 1 + a b) (tan(x/2) = sin x / (1 + cos x)):
+    // one atan2 where two atans and a tan were.
+    const double a = t / h, b = (S - t) / h;
+    const double angle = std::atan2(S / h, 1.0 - a * b);
+    const double middleTangent = (b - a) / (std::sqrt((1.0 + a * a) * (1.0 + b * b)) + 1.0 + a * b);
     double transmittance = 1.0;
     const HomogeneousMedium& medium = scene_.media()[segment.medium];
     if (node.medium == segment.medium && medium.boundaryConvex())
         transmittance = largestChannel(medium.transmittance(float(hBox)));
-    return w * transmittance * std::max(angle, 0.0) / h *
-           phaseFactor(index, segment, centre, t + h * std::tan(0.5 * (thetaA + thetaB)));
+    return w * transmittance * std::max(angle, 0.0) / h * phaseFactor(index, segment, centre, t + h * middleTangent);
 }
 
 double VrlImportance::phaseFactor(int32_t index, const CameraSegment& segment, const Vec3& centre, double u) const {

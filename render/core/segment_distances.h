@@ -1,6 +1,6 @@
 // The smallest distance from a line to many segments, in double SIMD lanes
 // (Google Highway, run-time dispatch): the exact h_min of small light-tree
-// nodes (ClusterBound::minimumDistance). Per segment it is the arithmetic of
+// nodes (ClusterBound::minimumDistance) and the edges of distanceLineBox. Per segment it is the arithmetic of
 // distanceLineSegment (render/core/distance.h) in the same order, without fused
 // multiply-adds, so the result equals the scalar loop's bit for bit and the
 // cluster bounds' margins are unchanged.

@@ -1,12 +1,12 @@
 // Line-to-segments distances in double lanes (contract: segment_distances.h).
 
 #undef HWY_TARGET_INCLUDE
-#define HWY_TARGET_INCLUDE "render/lightcuts/segment_distances.cpp"
+#define HWY_TARGET_INCLUDE "render/core/segment_distances.cpp"
 #include <hwy/foreach_target.h>  // IWYU pragma: keep
 
 #include <hwy/highway.h>
 
-#include "render/lightcuts/segment_distances.h"
+#include "render/core/segment_distances.h"
 
 #include <limits>
 
