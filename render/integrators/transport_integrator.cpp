@@ -24,10 +24,12 @@ TransportIntegrator::TransportIntegrator(const Scene& scene, const VrlSet& vrls,
                                                                      settings.cut);
     else if (tree_) {
         // One set of direction cones for both cuts' bounds, only where a medium is anisotropic.
+        // and one LeafSegments (exact distances of small nodes).
         if (DirectionCones::neededFor(scene.media())) cones_ = std::make_unique<DirectionCones>(*tree_);
-        lightcuts_ = std::make_unique<LightcutsEstimator>(scene, *tree_, estimator_, settings.cut, cones_.get());
-        surfaceLightcuts_ =
-            std::make_unique<SurfaceLightcutsEstimator>(scene, *tree_, surfaceEstimator_, settings.cut, cones_.get());
+        leaves_ = std::make_unique<LeafSegments>(*tree_);
+        lightcuts_ = std::make_unique<LightcutsEstimator>(scene, *tree_, estimator_, settings.cut, cones_.get(), leaves_.get());
+        surfaceLightcuts_ = std::make_unique<SurfaceLightcutsEstimator>(scene, *tree_, surfaceEstimator_, settings.cut,
+                                                                        cones_.get(), leaves_.get());
     } else if (settings.transports.has(TransportPart::Multiple)) {
         // Plain VRLs: every VRL for every segment, in SIMD lanes.
         plainLanes_ = std::make_unique<VrlLanes>(vrls.vrls, scene);

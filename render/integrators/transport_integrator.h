@@ -101,6 +101,7 @@ private:
     VrlSurfaceEstimator surfaceEstimator_;
     const LightTree* tree_;
     std::unique_ptr<DirectionCones> cones_;  // vrl-lightcuts with an HG medium: shared by both cuts' bounds
+    std::unique_ptr<LeafSegments> leaves_;   // vrl-lightcuts: shared by both cuts' bounds
     std::unique_ptr<LightcutsEstimator> lightcuts_;
     std::unique_ptr<SurfaceLightcutsEstimator> surfaceLightcuts_;
     std::unique_ptr<StochasticLightcutsEstimator> stochastic_;

@@ -58,8 +58,9 @@ std::pair<double, double> polarCosines(const V3d& o, const V3d& omega, double le
 }  // namespace
 
 ClusterBound::ClusterBound(const Scene& scene, const LightTree& tree, ClusterBoundSettings settings,
-                           const DirectionCones* cones)
-    : scene_(scene), tree_(tree), settings_(settings), leaves_(tree) {
+                           const DirectionCones* cones, const LeafSegments* leaves)
+    : scene_(scene), tree_(tree), settings_(settings) {
+    leaves_ = LeafSegments::shareOrBuild(leaves, tree, ownedLeaves_);
     for (const auto& m : scene.media()) {
         for (int c = 0; c < 3; ++c) maxSigmaS_[c] = std::max(maxSigmaS_[c], m.sigmaS()[c]);
         allIsotropic_ = allIsotropic_ && m.phase().isIsotropic();
@@ -155,7 +156,7 @@ double ClusterBound::minimumDistance(int32_t index, const CameraSegment& segment
         return distanceLineBox(segment.origin, segment.direction, node.box);
     }
     // Small node: the exact distance from its VRL segments (a contiguous range).
-    return leaves_.minDistanceToLine(index, segment.origin, segment.direction);
+    return leaves_->minDistanceToLine(index, segment.origin, segment.direction);
 }
 
 Rgb ClusterBound::bound(int32_t index, const CameraSegment& segment, bool* lineCrossesNode) const {

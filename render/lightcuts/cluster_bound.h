@@ -78,7 +78,7 @@ public:
     // `cones`: the tree's DirectionCones when the caller shares them between bounds
     // (TransportIntegrator); built here when needed and not given.
     ClusterBound(const Scene& scene, const LightTree& tree, ClusterBoundSettings settings = {},
-                 const DirectionCones* cones = nullptr);
+                 const DirectionCones* cones = nullptr, const LeafSegments* leaves = nullptr);
 
     // RGB bound for `node` against `segment`; +infinity when the
     // camera line passes through the node (h_min = 0).
@@ -97,7 +97,8 @@ private:
     ClusterBoundSettings settings_;
     Rgb maxSigmaS_{0.0f};  // over all media: for nodes spanning several
     bool allIsotropic_ = true;
-    LeafSegments leaves_;
+    const LeafSegments* leaves_ = nullptr;  // shared or owned
+    std::unique_ptr<LeafSegments> ownedLeaves_;
     // HgBound::Cones in a scene with an HG medium: the tree's cones (shared or owned); else null.
     const DirectionCones* cones_ = nullptr;
     std::unique_ptr<DirectionCones> ownedCones_;

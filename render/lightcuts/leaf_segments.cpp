@@ -10,8 +10,10 @@ LeafSegments::LeafSegments(const LightTree& tree) : tree_(tree) {
     if (tree.empty()) return;
     const auto& nodes = tree.nodes();
     first_.assign(nodes.size(), 0);
-    start_.reserve(tree.vrls().size());
-    end_.reserve(tree.vrls().size());
+    for (auto& lane : lanes_) {
+        lane.reserve(tree.vrls().size() + kSegmentLanesPadding);
+        lane.clear();
+    }
     // Post-order walk, left before right: leaves append their endpoints; an inner
     // node's first leaf is its left child's.
     std::vector<std::pair<int32_t, bool>> walk{{tree.root(), false}};
@@ -20,9 +22,12 @@ LeafSegments::LeafSegments(const LightTree& tree) : tree_(tree) {
         walk.pop_back();
         if (nodes[i].isLeaf()) {
             const Vrl& v = tree.vrls()[nodes[i].representative];
-            first_[i] = uint32_t(start_.size());
-            start_.push_back(v.origin);
-            end_.push_back(v.end());
+            first_[i] = uint32_t(lanes_[0].size());
+            const Vec3 end = v.end();
+            for (int axis = 0; axis < 3; ++axis) {
+                lanes_[axis].push_back(v.origin[axis]);
+                lanes_[3 + axis].push_back(end[axis]);
+            }
             continue;
         }
         if (!visited) {
@@ -33,12 +38,13 @@ LeafSegments::LeafSegments(const LightTree& tree) : tree_(tree) {
             first_[i] = first_[nodes[i].left];
         }
     }
-    for (auto& lane : lanes_) lane.assign(start_.size() + kSegmentLanesPadding, 0.0f);
-    for (size_t k = 0; k < start_.size(); ++k)
-        for (int axis = 0; axis < 3; ++axis) {
-            lanes_[axis][k] = start_[k][axis];
-            lanes_[3 + axis][k] = end_[k][axis];
-        }
+    for (auto& lane : lanes_) lane.resize(lane.size() + kSegmentLanesPadding, 0.0f);
+}
+
+size_t LeafSegments::memoryBytes() const {
+    size_t bytes = first_.capacity() * sizeof(uint32_t);
+    for (const auto& lane : lanes_) bytes += lane.capacity() * sizeof(float);
+    return bytes;
 }
 
 double LeafSegments::minDistanceToLine(int32_t node, const Vec3& origin, const Vec3& direction) const {

@@ -1,13 +1,15 @@
 // LeafSegments: the VRL segments of a light tree in depth-first leaf order, so
 // that every node's VRLs are one contiguous range. The cluster bounds use it to
 // take exact distances for small nodes (a box is loose around a few segments).
+// Six float arrays (24 bytes per VRL), built once per integrator and shared by
+// the (c) and (d) bounds.
 #pragma once
 
 #include "render/core/geometry.h"
 #include "render/lightcuts/light_tree.h"
 
 #include <cstdint>
-#include <span>
+#include <memory>
 #include <vector>
 
 namespace vrl {
@@ -16,19 +18,26 @@ class LeafSegments {
 public:
     explicit LeafSegments(const LightTree& tree);
 
-    // Start and end points of the VRLs below `node`.
-    std::span<const Vec3> starts(int32_t node) const { return {&start_[first_[node]], count(node)}; }
-    std::span<const Vec3> ends(int32_t node) const { return {&end_[first_[node]], count(node)}; }
+    // The VRLs below `node` are k in [first(node), first(node) + count(node)).
+    size_t first(int32_t node) const { return first_[node]; }
+    size_t count(int32_t node) const { return tree_.nodes()[node].vrlCount; }
+    Vec3 start(size_t k) const { return {lanes_[0][k], lanes_[1][k], lanes_[2][k]}; }
+    Vec3 end(size_t k) const { return {lanes_[3][k], lanes_[4][k], lanes_[5][k]}; }
     // The smallest distance from the line (origin, unit direction) to the VRLs below
     // `node`: distanceLineSegment's minimum, computed in SIMD lanes (segment_distances.h).
     double minDistanceToLine(int32_t node, const Vec3& origin, const Vec3& direction) const;
+    size_t memoryBytes() const;
+    // `shared` when given, else a new one kept in `owned`.
+    static const LeafSegments* shareOrBuild(const LeafSegments* shared, const LightTree& tree,
+                                            std::unique_ptr<LeafSegments>& owned) {
+        if (shared) return shared;
+        owned = std::make_unique<LeafSegments>(tree);
+        return owned.get();
+    }
 
 private:
-    size_t count(int32_t node) const { return tree_.nodes()[node].vrlCount; }
-
     const LightTree& tree_;
-    std::vector<Vec3> start_, end_;
-    std::vector<float> lanes_[6];  // the same points as six float arrays (x, y, z of starts, of ends), padded
+    std::vector<float> lanes_[6];  // x, y, z of the starts, of the ends; padded for the SIMD lanes
     std::vector<uint32_t> first_;  // per node: index of its first leaf
 };
 

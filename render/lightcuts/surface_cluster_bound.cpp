@@ -23,8 +23,9 @@ float phaseMaximum(const PhaseFunction& phase) {
 }  // namespace
 
 SurfaceClusterBound::SurfaceClusterBound(const Scene& scene, const LightTree& tree, ClusterBoundSettings settings,
-                                         const DirectionCones* cones)
-    : scene_(scene), tree_(tree), settings_(settings), leaves_(tree) {
+                                         const DirectionCones* cones, const LeafSegments* leaves)
+    : scene_(scene), tree_(tree), settings_(settings) {
+    leaves_ = LeafSegments::shareOrBuild(leaves, tree, ownedLeaves_);
     for (const auto& m : scene.media()) {
         for (int c = 0; c < 3; ++c) maxSigmaS_[c] = std::max(maxSigmaS_[c], m.sigmaS()[c]);
         maxPhase_ = std::max(maxPhase_, phaseMaximum(m.phase()));
@@ -75,8 +76,9 @@ double SurfaceClusterBound::minimumDistance(int32_t index, const Vec3& x) const 
     const LightTreeNode& node = tree_.nodes()[index];
     if (node.vrlCount > settings_.exactDistanceBelow) return distancePointBox(x, node.box);
     double best = std::numeric_limits<double>::infinity();
-    const auto starts = leaves_.starts(index), ends = leaves_.ends(index);
-    for (size_t k = 0; k < starts.size(); ++k) best = std::min(best, distancePointSegment(x, starts[k], ends[k]));
+    const size_t first = leaves_->first(index), count = leaves_->count(index);
+    for (size_t k = first; k < first + count; ++k)
+        best = std::min(best, distancePointSegment(x, leaves_->start(k), leaves_->end(k)));
     return best;
 }
 

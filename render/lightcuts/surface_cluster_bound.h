@@ -58,7 +58,7 @@ class SurfaceClusterBound {
 public:
     // `cones`: shared DirectionCones of the tree (built here when the scene has an HG medium and none are given).
     SurfaceClusterBound(const Scene& scene, const LightTree& tree, ClusterBoundSettings settings = {},
-                        const DirectionCones* cones = nullptr);
+                        const DirectionCones* cones = nullptr, const LeafSegments* leaves = nullptr);
 
     // RGB bound for `node` lighting `x`; +infinity (and *xInsideNode = true) when
     // x lies in the node's box (or on one of a small node's segments).
@@ -77,7 +77,8 @@ private:
     ClusterBoundSettings settings_;
     Rgb maxSigmaS_{0.0f};   // over all media: for nodes spanning several
     float maxPhase_ = 0.0f;  // largest phase-function value of any medium
-    LeafSegments leaves_;
+    const LeafSegments* leaves_ = nullptr;  // shared or owned
+    std::unique_ptr<LeafSegments> ownedLeaves_;
     const DirectionCones* cones_ = nullptr;  // with an HG medium: the tree's cones (shared or owned)
     std::unique_ptr<DirectionCones> ownedCones_;
 };

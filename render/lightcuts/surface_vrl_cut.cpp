@@ -7,8 +7,8 @@ namespace vrl {
 
 SurfaceLightcutsEstimator::SurfaceLightcutsEstimator(const Scene& scene, const LightTree& tree,
                                                      const VrlSurfaceEstimator& estimator, CutSettings settings,
-                                                     const DirectionCones* cones)
-    : tree_(tree), estimator_(estimator), settings_(settings), bound_(scene, tree, settings.bound, cones) {}
+                                                     const DirectionCones* cones, const LeafSegments* leaves)
+    : tree_(tree), estimator_(estimator), settings_(settings), bound_(scene, tree, settings.bound, cones, leaves) {}
 
 Rgb SurfaceLightcutsEstimator::estimate(const CameraPathSurface& x, uint64_t streamKey, CutStatistics& statistics,
                                         float otherLuminance) const {

@@ -20,9 +20,10 @@ namespace vrl {
 
 class SurfaceLightcutsEstimator {
 public:
-    // `cones`: the tree's DirectionCones, shared with the medium cut (optional).
+    // `cones`, `leaves`: the tree's DirectionCones and LeafSegments, shared with the medium cut (optional).
     SurfaceLightcutsEstimator(const Scene& scene, const LightTree& tree, const VrlSurfaceEstimator& estimator,
-                              CutSettings settings, const DirectionCones* cones = nullptr);
+                              CutSettings settings, const DirectionCones* cones = nullptr,
+                       const LeafSegments* leaves = nullptr);
 
     // Part (c) at x from every VRL of the tree. VRL k draws from vrlStream(streamKey, k)
     // as in plain VRL shading, so a cluster's estimate is its representative's plain sample rescaled.

@@ -8,8 +8,8 @@
 namespace vrl {
 
 LightcutsEstimator::LightcutsEstimator(const Scene& scene, const LightTree& tree, const VrlEstimator& estimator,
-                                       CutSettings settings, const DirectionCones* cones)
-    : tree_(tree), estimator_(estimator), settings_(settings), bound_(scene, tree, settings.bound, cones) {}
+                                       CutSettings settings, const DirectionCones* cones, const LeafSegments* leaves)
+    : tree_(tree), estimator_(estimator), settings_(settings), bound_(scene, tree, settings.bound, cones, leaves) {}
 
 Rgb LightcutsEstimator::estimate(const CameraSegment& segment, uint64_t streamKey, CutStatistics& statistics) const {
     if (tree_.empty() || !(segment.length > 0.0f)) return Rgb(0.0f);

@@ -19,9 +19,10 @@ namespace vrl {
 
 class LightcutsEstimator {
 public:
-    // `cones`: the tree's DirectionCones, shared with the surface cut (optional).
+    // `cones`, `leaves`: the tree's DirectionCones and LeafSegments, shared with the surface cut (optional).
     LightcutsEstimator(const Scene& scene, const LightTree& tree, const VrlEstimator& estimator, CutSettings settings,
-                       const DirectionCones* cones = nullptr);
+                       const DirectionCones* cones = nullptr,
+                       const LeafSegments* leaves = nullptr);
 
     // Multiple scattering from every VRL of the tree along `segment`. The sample of
     // VRL k comes from the stream (streamKey, k) (see vrlStream), as in plain VRL
