@@ -9,6 +9,10 @@
 // isotropic strategy (no tables are built for isotropic media).
 // Degenerate configurations (parallel, crossing, touching, zero length) fall
 // back to limiting pdfs: results stay finite and unbiased.
+// The estimate itself is computed by the SIMD kernel (vrl_kernel.h: float lanes,
+// the lines' geometry in double); the double-precision samplers below draw the
+// same points from the same numbers and serve single scattering, part (c) and
+// the tests that check the kernel sample by sample.
 #pragma once
 
 #include "render/core/rng.h"
