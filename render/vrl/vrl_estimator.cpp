@@ -156,9 +156,9 @@ Rgb VrlEstimator::finish(const CameraSegment& segment, const KernelOutput& out, 
            scene_.transmittance(xu, xv, segment.medium);
 }
 
-Rgb VrlEstimator::contribution(const Vrl& vrl, const CameraSegment& segment, Rng& rng) const {
-    if (!(vrl.length > 0.0f) || !(segment.length > 0.0f)) return Rgb(0.0f);
-    // One VRL in lane 0 of a padded batch (zero-length VRLs in the others).
+void VrlEstimator::evaluateFew(const Vrl* const vrls[], const Rgb fluxes[], Rng* const rngs[], size_t n,
+                               const CameraSegment& segment, Rgb* result) const {
+    // n <= kKernelPadding VRLs in the lanes of one padded batch (zero-length VRLs after them).
     constexpr size_t P = kKernelPadding;
     alignas(64) float in[VrlLanes::kArrays][P] = {};
     alignas(64) int32_t media[P] = {};
@@ -167,18 +167,33 @@ Rgb VrlEstimator::contribution(const Vrl& vrl, const CameraSegment& segment, Rng
     alignas(64) int32_t deferred[P];
     float* arrays[VrlLanes::kArrays];
     for (int a = 0; a < VrlLanes::kArrays; ++a) arrays[a] = in[a];
-    VrlLanes::write(vrl, scene_, arrays, media, 0);
-    const KernelVrls vrls = VrlLanes::view(arrays, media);
+    for (size_t j = 0; j < n; ++j) {
+        Vrl vrl = *vrls[j];
+        vrl.flux = fluxes[j];
+        VrlLanes::write(vrl, scene_, arrays, media, j);
+    }
     const float* const numbers[4] = {xi[0], xi[1], xi[2], xi[3]};
     const KernelOutput out{r, g, b, u, vx, vy, vz, deferred};
     const KernelSegment k = kernelSegment(segment);
-    Rgb sum(0.0f);
+    Rgb sum[P];
     for (int i = 0; i < samplesPerVrl_; ++i) {
-        for (auto& x : xi) x[0] = rng.next();
-        evaluateVrlLanes(k, vrls, numbers, out, 1);
-        sum += finish(segment, out, 0);
+        for (size_t j = 0; j < n; ++j)
+            for (auto& x : xi) x[j] = rngs[j]->next();
+        evaluateVrlLanes(k, VrlLanes::view(arrays, media), numbers, out, n);
+        for (size_t j = 0; j < n; ++j) sum[j] = i == 0 ? finish(segment, out, j) : sum[j] + finish(segment, out, j);
     }
-    return sum * scene_.media()[size_t(segment.medium)].sigmaS() * segment.throughputBefore / float(samplesPerVrl_);
+    const Rgb after = scene_.media()[size_t(segment.medium)].sigmaS() * segment.throughputBefore / float(samplesPerVrl_);
+    for (size_t j = 0; j < n; ++j) result[j] = sum[j] * after;
+}
+
+Rgb VrlEstimator::contribution(const Vrl& vrl, const CameraSegment& segment, Rng& rng) const {
+    if (!(vrl.length > 0.0f) || !(segment.length > 0.0f)) return Rgb(0.0f);
+    const Vrl* const vrls[1] = {&vrl};
+    const Rgb fluxes[1] = {vrl.flux};
+    Rng* const rngs[1] = {&rng};
+    Rgb result;
+    evaluateFew(vrls, fluxes, rngs, 1, segment, &result);
+    return result;
 }
 
 void VrlEstimator::contributions(const Query* queries, size_t count, const CameraSegment& segment, uint64_t streamKey,
@@ -188,36 +203,18 @@ void VrlEstimator::contributions(const Query* queries, size_t count, const Camer
         return;
     }
     constexpr size_t P = kKernelPadding;
-    alignas(64) float in[VrlLanes::kArrays][P] = {};
-    alignas(64) int32_t media[P] = {};
-    alignas(64) float xi[4][P] = {};
-    alignas(64) float r[P], g[P], b[P], u[P], vx[P], vy[P], vz[P];
-    alignas(64) int32_t deferred[P];
-    float* arrays[VrlLanes::kArrays];
-    for (int a = 0; a < VrlLanes::kArrays; ++a) arrays[a] = in[a];
-    const KernelVrls vrls = VrlLanes::view(arrays, media);
-    const float* const numbers[4] = {xi[0], xi[1], xi[2], xi[3]};
-    const KernelOutput out{r, g, b, u, vx, vy, vz, deferred};
-    const KernelSegment k = kernelSegment(segment);
-    const Rgb after = scene_.media()[size_t(segment.medium)].sigmaS() * segment.throughputBefore / float(samplesPerVrl_);
     for (size_t first = 0; first < count; first += P) {
         const size_t n = std::min(P, count - first);
+        const Vrl* vrls[P];
+        Rgb fluxes[P];
         std::optional<Rng> streams[P];
+        Rng* rngs[P];
         for (size_t j = 0; j < n; ++j) {
-            Vrl vrl = *queries[first + j].vrl;
-            vrl.flux = queries[first + j].flux;
-            VrlLanes::write(vrl, scene_, arrays, media, j);
-            streams[j].emplace(vrlStream(streamKey, queries[first + j].stream));
+            vrls[j] = queries[first + j].vrl;
+            fluxes[j] = queries[first + j].flux;
+            rngs[j] = &streams[j].emplace(vrlStream(streamKey, queries[first + j].stream));
         }
-        for (size_t j = n; j < P; ++j) in[VrlLanes::kLength][j] = 0.0f;  // padding: nothing
-        Rgb sum[P];
-        for (int i = 0; i < samplesPerVrl_; ++i) {
-            for (size_t j = 0; j < n; ++j)
-                for (auto& x : xi) x[j] = streams[j]->next();
-            evaluateVrlLanes(k, vrls, numbers, out, n);
-            for (size_t j = 0; j < n; ++j) sum[j] = i == 0 ? finish(segment, out, j) : sum[j] + finish(segment, out, j);
-        }
-        for (size_t j = 0; j < n; ++j) result[first + j] = sum[j] * after;
+        evaluateFew(vrls, fluxes, rngs, n, segment, result + first);
     }
 }
 

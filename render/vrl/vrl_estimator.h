@@ -85,6 +85,10 @@ public:
 
 private:
     KernelSegment kernelSegment(const CameraSegment& segment) const;
+    // contribution() of n <= kKernelPadding VRLs (flux replaced by fluxes[j], numbers
+    // from rngs[j], four per sample) in one batch's lanes.
+    void evaluateFew(const Vrl* const vrls[], const Rgb fluxes[], Rng* const rngs[], size_t n,
+                     const CameraSegment& segment, Rgb* result) const;
     // Lane k's estimate, with the transmittance of a deferred lane.
     Rgb finish(const CameraSegment& segment, const KernelOutput& out, size_t k) const;
 
