@@ -103,13 +103,15 @@ int32_t stochasticDescent(const LightTree& tree, int32_t node, Rng& rng, Importa
     probability = 1.0;
     while (!nodes[node].isLeaf()) {
         const LightTreeNode& n = nodes[node];
-        // The next level's nodes, while this level's importances are computed (a
-        // descent is a chain of cache misses otherwise).
+        // The next level's nodes (both cache lines of each), while this level's
+        // importances are computed: a descent is a chain of cache misses otherwise.
+        const auto prefetch = [&](int32_t i) {
+            const char* p = reinterpret_cast<const char*>(&nodes[i]);
+            __builtin_prefetch(p);
+            __builtin_prefetch(p + sizeof(LightTreeNode) - 1);
+        };
         for (const int32_t child : {n.left, n.right})
-            if (!nodes[child].isLeaf()) {
-                __builtin_prefetch(&nodes[nodes[child].left]);
-                __builtin_prefetch(&nodes[nodes[child].right]);
-            }
+            if (!nodes[child].isLeaf()) prefetch(nodes[child].left), prefetch(nodes[child].right);
         const double pl = leftProbability(importance(n.left), importance(n.right), nodes[n.left], nodes[n.right]);
         if (importanceEvaluations) *importanceEvaluations += 2;
         if (rng.nextDouble() < pl) {
