@@ -374,6 +374,16 @@ Vrl randomVrl(Rng& rng, const Region& region, const ReferenceLine& line, int med
     return v;
 }
 
+// A light tree over `count` random VRLs (medium 0) around a random reference line
+// of the default region, drawn from `rng` in that order.
+LightTree randomTreeAroundALine(Rng& rng, int count) {
+    const Region region;
+    const ReferenceLine line = randomReferenceLine(rng, region);
+    std::vector<Vrl> vrls;
+    for (int i = 0; i < count; ++i) vrls.push_back(randomVrl(rng, region, line, 0));
+    return LightTree::build(vrls);
+}
+
 enum class SegmentKind { AlongLine, Anywhere, NearVrl, Count };
 constexpr const char* kSegmentKindNames[] = {"along the reference line", "anywhere", "grazing a VRL"};
 
@@ -625,11 +635,7 @@ TEST(ClusterBound, BoundsIsotropicEstimateWithSphereDistances) {
     // The sphere path is taken: far from a 150-VRL tree, large nodes get a distance
     // below the box's (never above it), small ones the same.
     Rng rng(124, 0);
-    const Region region;
-    const ReferenceLine line = randomReferenceLine(rng, region);
-    std::vector<Vrl> vrls;
-    for (int i = 0; i < 150; ++i) vrls.push_back(randomVrl(rng, region, line, 0));
-    const LightTree tree = LightTree::build(vrls);
+    const LightTree tree = randomTreeAroundALine(rng, 150);
     const ClusterBound box(*scene, tree), sphere(*scene, tree, plan.settings);
     CameraSegment far;
     far.origin = Vec3(-30.0f, 20.0f, 25.0f);
@@ -977,11 +983,7 @@ TEST(ClusterBound, AnisotropyEpsilonScalesTheIsotropicBound) {
     const auto isotropic = unboundedScene(Rgb(0.2f, 0.5f, 1.0f), Rgb(0.1f), 0.0f);
     const auto hg = unboundedScene(Rgb(0.2f, 0.5f, 1.0f), Rgb(0.1f), 0.7f);
     Rng rng(111, 0);
-    const Region region;
-    const ReferenceLine line = randomReferenceLine(rng, region);
-    std::vector<Vrl> vrls;
-    for (int i = 0; i < 40; ++i) vrls.push_back(randomVrl(rng, region, line, 0));
-    const LightTree tree = LightTree::build(vrls);
+    const LightTree tree = randomTreeAroundALine(rng, 40);
     CameraSegment segment;  // its line z = 10 passes clear of the VRLs (|z| < 4): finite bounds
     segment.origin = Vec3(-5.0f, 0.3f, 10.0f);
     segment.direction = Vec3(1.0f, 0.0f, 0.0f);
