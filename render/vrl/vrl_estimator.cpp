@@ -3,7 +3,6 @@
 #include "render/scene/scene.h"
 
 #include <algorithm>
-#include <array>
 #include <cmath>
 #include <optional>
 

@@ -9,6 +9,7 @@
 #include <hwy/contrib/math/math-inl.h>
 #include <hwy/highway.h>
 
+#include "render/core/geometry.h"  // kPi, kInv4Pi
 #include "render/vrl/vrl_estimator.h"
 #include "render/vrl/vrl_kernel.h"
 
@@ -17,8 +18,6 @@ namespace vrl {
 namespace HWY_NAMESPACE {
 namespace hn = hwy::HWY_NAMESPACE;
 
-constexpr float kPi = 3.14159265358979323846f;
-constexpr float kInv4Pi = 0.07957747154594767f;
 
 template <class D, class V = hn::Vec<D>>
 HWY_INLINE V Dot(V ax, V ay, V az, V bx, V by, V bz) {
