@@ -175,11 +175,12 @@ void VrlEstimator::evaluateFew(const Vrl* const vrls[], const Rgb fluxes[], Rng*
     const KernelOutput out{r, g, b, u, vx, vy, vz, deferred};
     const KernelSegment k = kernelSegment(segment);
     Rgb sum[P];
+    std::fill(sum, sum + P, Rgb(0.0f));
     for (int i = 0; i < samplesPerVrl_; ++i) {
         for (size_t j = 0; j < n; ++j)
             for (auto& x : xi) x[j] = rngs[j]->next();
         evaluateVrlLanes(k, VrlLanes::view(arrays, media), numbers, out, n);
-        for (size_t j = 0; j < n; ++j) sum[j] = i == 0 ? finish(segment, out, j) : sum[j] + finish(segment, out, j);
+        for (size_t j = 0; j < n; ++j) sum[j] += finish(segment, out, j);
     }
     const Rgb after = scene_.media()[size_t(segment.medium)].sigmaS() * segment.throughputBefore / float(samplesPerVrl_);
     for (size_t j = 0; j < n; ++j) result[j] = sum[j] * after;
@@ -190,7 +191,7 @@ Rgb VrlEstimator::contribution(const Vrl& vrl, const CameraSegment& segment, Rng
     const Vrl* const vrls[1] = {&vrl};
     const Rgb fluxes[1] = {vrl.flux};
     Rng* const rngs[1] = {&rng};
-    Rgb result;
+    Rgb result(0.0f);
     evaluateFew(vrls, fluxes, rngs, 1, segment, &result);
     return result;
 }
