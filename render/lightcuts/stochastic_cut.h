@@ -35,32 +35,44 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
-#include <queue>
 #include <vector>
 
 namespace vrl {
 
+// What an importance provider returns for an inner node: its two children (left,
+// right) and their importances (a NaN counts as infinite). Importances come in
+// pairs because every use needs both children's: the cut refines a node into
+// both, the descent chooses between them.
+struct ChildImportances {
+    int32_t node[2];
+    double value[2];
+};
+
 // The probability of taking the left child, from the children's importances and
 // (fallback) their flux x length. In [0, 1]; 0 or 1 only when one importance is 0
 // and the other positive (or, in the fallback, one flux x length is 0).
-inline double leftProbability(double importanceLeft, double importanceRight, const LightTreeNode& left,
-                              const LightTreeNode& right) {
-    const double sum = importanceLeft + importanceRight;
-    if (sum > 0.0 && std::isfinite(sum)) return importanceLeft / sum;
+inline double leftProbability(const ChildImportances& c, const LightTree& tree) {
+    const double sum = c.value[0] + c.value[1];
+    if (sum > 0.0 && std::isfinite(sum)) return c.value[0] / sum;
+    const LightTreeNode& left = tree.nodes()[c.node[0]];
+    const LightTreeNode& right = tree.nodes()[c.node[1]];
     const double fl = double(left.fluxLength.x) + left.fluxLength.y + left.fluxLength.z;
     const double fr = double(right.fluxLength.x) + right.fluxLength.y + right.fluxLength.z;
     if (fl + fr > 0.0 && std::isfinite(fl + fr)) return fl / (fl + fr);
     return 0.5;
 }
 
+// Leaves are the tree's first vrls().size() nodes (light_tree.h).
+inline bool isLeafNode(const LightTree& tree, int32_t node) { return size_t(node) < tree.vrls().size(); }
+
 // The cut of at most `cutSize` nodes (leaves and inner nodes), refining by largest
-// importance (`importance`: double(int32_t node); a NaN counts as infinite). Adds
-// the number of importance evaluations to *importanceEvaluations.
+// importance (`importance`: ChildImportances(int32_t innerNode)). Adds the number
+// of importance evaluations to *importanceEvaluations. `cut` is cleared first.
 template <class Importance>
-std::vector<int32_t> stochasticCut(const LightTree& tree, uint32_t cutSize, Importance&& importance,
-                                   uint32_t* importanceEvaluations = nullptr) {
-    std::vector<int32_t> cut;
-    if (tree.empty()) return cut;
+void stochasticCut(const LightTree& tree, uint32_t cutSize, Importance&& importance, std::vector<int32_t>& cut,
+                   uint32_t* importanceEvaluations = nullptr) {
+    cut.clear();
+    if (tree.empty()) return;
     struct Entry {
         double importance;
         int32_t node;
@@ -68,29 +80,44 @@ std::vector<int32_t> stochasticCut(const LightTree& tree, uint32_t cutSize, Impo
             return importance != o.importance ? importance < o.importance : node > o.node;
         }
     };
-    const auto& nodes = tree.nodes();
-    std::priority_queue<Entry> inner;
-    const auto add = [&](int32_t i) {
-        if (nodes[i].isLeaf()) {
-            cut.push_back(i);
-            return;
+    // A heap of at most cutSize entries, reused by the thread (no allocation per query).
+    thread_local std::vector<Entry> inner;
+    inner.clear();
+    const int32_t root = tree.root();
+    if (isLeafNode(tree, root)) {
+        cut.push_back(root);
+        return;
+    }
+    // The root's own importance is never compared with anything.
+    inner.push_back({0.0, root});
+    const size_t size = std::max<uint32_t>(cutSize, 1u);
+    while (!inner.empty() && cut.size() + inner.size() < size) {
+        std::pop_heap(inner.begin(), inner.end());
+        const int32_t i = inner.back().node;
+        inner.pop_back();
+        const ChildImportances c = importance(i);
+        if (importanceEvaluations) *importanceEvaluations += 2;
+        for (int k = 0; k < 2; ++k) {
+            if (isLeafNode(tree, c.node[k])) {
+                cut.push_back(c.node[k]);
+                continue;
+            }
+            double value = c.value[k];
+            if (!(value >= 0.0)) value = std::numeric_limits<double>::infinity();  // NaN: refine first
+            inner.push_back({value, c.node[k]});
+            std::push_heap(inner.begin(), inner.end());
         }
-        if (importanceEvaluations) ++*importanceEvaluations;
-        double value = importance(i);
-        if (!(value >= 0.0)) value = std::numeric_limits<double>::infinity();  // NaN: refine first
-        inner.push({value, i});
-    };
-    add(tree.root());
-    while (!inner.empty() && cut.size() + inner.size() < std::max<uint32_t>(cutSize, 1u)) {
-        const int32_t i = inner.top().node;
-        inner.pop();
-        add(nodes[i].left);
-        add(nodes[i].right);
     }
-    while (!inner.empty()) {
-        cut.push_back(inner.top().node);
-        inner.pop();
-    }
+    // The remaining inner nodes, in decreasing importance (the order of the old queue).
+    std::sort_heap(inner.begin(), inner.end());
+    for (auto it = inner.rbegin(); it != inner.rend(); ++it) cut.push_back(it->node);
+}
+
+template <class Importance>
+std::vector<int32_t> stochasticCut(const LightTree& tree, uint32_t cutSize, Importance&& importance,
+                                   uint32_t* importanceEvaluations = nullptr) {
+    std::vector<int32_t> cut;
+    stochasticCut(tree, cutSize, importance, cut, importanceEvaluations);
     return cut;
 }
 
@@ -99,48 +126,46 @@ std::vector<int32_t> stochasticCut(const LightTree& tree, uint32_t cutSize, Impo
 template <class Importance>
 int32_t stochasticDescent(const LightTree& tree, int32_t node, Rng& rng, Importance&& importance, double& probability,
                           uint32_t* importanceEvaluations = nullptr) {
-    const auto& nodes = tree.nodes();
     probability = 1.0;
-    while (!nodes[node].isLeaf()) {
-        const LightTreeNode& n = nodes[node];
-        // The next level's nodes (both cache lines of each), while this level's
-        // importances are computed: a descent is a chain of cache misses otherwise.
-        const auto prefetch = [&](int32_t i) {
-            const char* p = reinterpret_cast<const char*>(&nodes[i]);
-            __builtin_prefetch(p);
-            __builtin_prefetch(p + sizeof(LightTreeNode) - 1);
-        };
-        for (const int32_t child : {n.left, n.right})
-            if (!nodes[child].isLeaf()) prefetch(nodes[child].left), prefetch(nodes[child].right);
-        const double pl = leftProbability(importance(n.left), importance(n.right), nodes[n.left], nodes[n.right]);
+    while (!isLeafNode(tree, node)) {
+        const ChildImportances c = importance(node);
+        const double pl = leftProbability(c, tree);
         if (importanceEvaluations) *importanceEvaluations += 2;
         if (rng.nextDouble() < pl) {
             probability *= pl;
-            node = n.left;
+            node = c.node[0];
         } else {
             probability *= 1.0 - pl;
-            node = n.right;
+            node = c.node[1];
         }
     }
     return node;
 }
 
-// The stochastic cut estimate: sum over the cut of leafEstimate(leaf node, rng) / P.
-// `leafEstimate`: Rgb(int32_t leafNode, Rng&).
-template <class Importance, class LeafEstimate>
+// The stochastic cut estimate: every cut node draws one leaf (in cut order, each
+// descent drawing from `rng`), then leafEstimates(leaves, count, rng, out) gives
+// their one-VRL estimates at once (SIMD lanes), each divided by its probability.
+// `leafEstimates`: void(const int32_t* leaves, size_t count, Rng&, Rgb* out).
+template <class Importance, class LeafEstimates>
 Rgb stochasticCutEstimate(const LightTree& tree, uint32_t cutSize, Rng& rng, CutStatistics& statistics,
-                          Importance&& importance, LeafEstimate&& leafEstimate) {
-    Rgb total(0.0f);
+                          Importance&& importance, LeafEstimates&& leafEstimates) {
+    thread_local std::vector<int32_t> cut;
+    thread_local std::vector<int32_t> leaves;
+    thread_local std::vector<double> probabilities;
+    thread_local std::vector<Rgb> estimates;
     uint32_t evaluations = 0;
-    const std::vector<int32_t> cut = stochasticCut(tree, cutSize, importance, &evaluations);
-    for (const int32_t c : cut) {
-        double probability = 1.0;
-        const int32_t leaf = stochasticDescent(tree, c, rng, importance, probability, &evaluations);
-        // probability > 0 by construction: a branch of probability 0 is never taken
-        // (rng.nextDouble() < 1 and a zero left probability sends every draw right).
-        total += leafEstimate(leaf, rng) * float(1.0 / probability);
-        ++statistics.evaluated;
-    }
+    stochasticCut(tree, cutSize, importance, cut, &evaluations);
+    leaves.resize(cut.size());
+    probabilities.resize(cut.size());
+    estimates.resize(cut.size());
+    for (size_t k = 0; k < cut.size(); ++k)
+        leaves[k] = stochasticDescent(tree, cut[k], rng, importance, probabilities[k], &evaluations);
+    leafEstimates(leaves.data(), leaves.size(), rng, estimates.data());
+    // probability > 0 by construction: a branch of probability 0 is never taken
+    // (rng.nextDouble() < 1 and a zero left probability sends every draw right).
+    Rgb total(0.0f);
+    for (size_t k = 0; k < cut.size(); ++k) total += estimates[k] * float(1.0 / probabilities[k]);
+    statistics.evaluated += uint32_t(cut.size());
     statistics.cutSize += uint32_t(cut.size());
     statistics.importanceEvaluations += evaluations;
     return total;
@@ -152,21 +177,20 @@ Rgb stochasticCutEstimate(const LightTree& tree, uint32_t cutSize, Rng& rng, Cut
 template <class Importance>
 std::vector<double> stochasticLeafProbabilities(const LightTree& tree, uint32_t cutSize, Importance&& importance) {
     std::vector<double> p(tree.vrls().size(), 0.0);
-    const auto& nodes = tree.nodes();
     std::vector<std::pair<int32_t, double>> stack;
     for (const int32_t c : stochasticCut(tree, cutSize, importance)) {
         stack.push_back({c, 1.0});
         while (!stack.empty()) {
             const auto [i, q] = stack.back();
             stack.pop_back();
-            if (nodes[i].isLeaf()) {
+            if (isLeafNode(tree, i)) {
                 p[size_t(i)] += q;
                 continue;
             }
-            const double pl = leftProbability(importance(nodes[i].left), importance(nodes[i].right),
-                                              nodes[nodes[i].left], nodes[nodes[i].right]);
-            stack.push_back({nodes[i].left, q * pl});
-            stack.push_back({nodes[i].right, q * (1.0 - pl)});
+            const ChildImportances children = importance(i);
+            const double pl = leftProbability(children, tree);
+            stack.push_back({children.node[0], q * pl});
+            stack.push_back({children.node[1], q * (1.0 - pl)});
         }
     }
     return p;

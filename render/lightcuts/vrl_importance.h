@@ -23,7 +23,8 @@
 // half their distance to u, else 1; f_V: the VRL's own, for single VRLs only,
 // else 1 — an inner node does not know its VRLs' directions); HG is positive
 // everywhere, so the factor never makes an importance 0.
-// Zero only if Phi L sigma_s is 0 (then every VRL's estimate is 0).
+// Zero only if Phi L sigma_s is 0 (then every VRL's estimate is 0): T_r is
+// floored at 1e-30 so that distance never makes an importance 0.
 //
 // Surface (c) (vrl_surface_estimator.h integrates Phi sigma_s f_p f_s |cos| T_r V / r^2
 // over the VRL):
@@ -32,11 +33,28 @@
 // SurfaceClusterBound bounds it; a single VRL in an HG medium also gets 4 pi
 // f_V towards x from its midpoint. Zero also when the box lies wholly behind a
 // surface that only reflects (SurfaceClusterBound proves those VRLs give 0).
+//
+// Cost. A descent computes two importances per level, so they are computed in
+// pairs from a compact copy of the tree made for this purpose: one 64-byte,
+// cache-line-aligned record per inner node with both children's boxes (float),
+// weights lum(Phi L sigma_s), node indices and media (one memory line per level
+// instead of two 72-byte tree nodes; (N - 1) x 64 bytes, built only for
+// vrl-stochastic). Per-query terms (the segment's, the surface point's) are
+// computed once per query (prepare()). Being a heuristic, the importance may be
+// approximate where that is cheaper, as long as it stays positive and finite:
+// h_box is the distance from the line to the box after three alternating
+// projections between them (an upper bound of the exact distance, equal to it
+// when the line crosses the box; the slab test detects that exactly), and the
+// angles use a polynomial arctangent (error < 1e-5 rad, positive for positive
+// arguments).
 #pragma once
 
 #include "render/core/rgb.h"
 #include "render/lightcuts/light_tree.h"
+#include "render/lightcuts/stochastic_cut.h"
 #include "render/vrl/camera_segment.h"
+
+#include <vector>
 
 namespace vrl {
 
@@ -49,18 +67,55 @@ public:
     VrlImportance(const Scene& scene, const LightTree& tree,
                   float minimumDistanceFraction = kDefaultMinimumDistanceFraction);
 
-    double segment(int32_t node, const CameraSegment& segment) const;
-    double surface(int32_t node, const CameraPathSurface& x) const;
+    // The terms of one camera segment (part (d)) or surface point (part (c)).
+    struct SegmentQuery {
+        Vec3 origin, direction, absDirection;
+        double length = 0.0, tinyBase = 0.0;
+        int medium = -1;
+        float sigmaTMin = 0.0f;  // > 0 only in a convex medium (T_r applies)
+        bool anisotropic = false;  // the camera's medium is HG
+    };
+    struct SurfaceQuery {
+        Vec3 position, facingNormal, shadingNormal;
+        double tinyBase = 0.0;
+        int medium = -1;
+        bool reflectsOnly = true, changesMedium = false;
+    };
+    SegmentQuery prepare(const CameraSegment& segment) const;
+    SurfaceQuery prepare(const CameraPathSurface& x) const;
+
+    // The two children of the inner node `parent` and their importances for the query.
+    ChildImportances children(int32_t parent, const SegmentQuery& query) const;
+    ChildImportances children(int32_t parent, const SurfaceQuery& query) const;
+
+    size_t memoryBytes() const { return pairs_.capacity() * sizeof(Pair); }
 
 private:
-    double weight(const LightTreeNode& node) const;  // lum(Phi L sigma_s)
-    // Anisotropic media: (4 pi)^2 f_V f_U towards the camera line's point at parameter u.
-    double phaseFactor(int32_t node, const CameraSegment& segment, const Vec3& centre, double u) const;
+    struct Child {
+        float lo[3], hi[3];
+        float weight;    // lum(Phi L sigma_s)
+        int32_t packed;  // node index | (medium + 1) << indexBits_ (medium code 0: several or unknown)
+    };
+    struct alignas(64) Pair {
+        Child child[2];
+    };
+    static_assert(sizeof(Pair) == 64);
+
+    int32_t nodeOf(const Child& c) const { return c.packed & indexMask_; }
+    int mediumOf(const Child& c) const { return int(uint32_t(c.packed) >> indexBits_) - 1; }
+    const Pair& pair(int32_t parent) const;
+    double segmentImportance(const Child& c, const SegmentQuery& q) const;
+    double surfaceImportance(const Child& c, const SurfaceQuery& q) const;
 
     const Scene& scene_;
     const LightTree& tree_;
     float fraction_;
-    Rgb maxSigmaS_{0.0f};
+    int32_t leafCount_ = 0;
+    int indexBits_ = 31;
+    int32_t indexMask_ = 0x7fffffff;
+    std::vector<Pair> pairs_;        // pairs_[parent - leafCount_]
+    std::vector<float> sigmaTMin_;   // per medium: smallest channel of sigma_t
+    std::vector<char> convex_, isotropic_;
 };
 
 }  // namespace vrl

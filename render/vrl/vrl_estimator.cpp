@@ -196,6 +196,27 @@ Rgb VrlEstimator::contribution(const Vrl& vrl, const CameraSegment& segment, Rng
     return result;
 }
 
+void VrlEstimator::contributions(const Vrl* vrls, const int32_t* indices, size_t count, const CameraSegment& segment,
+                                 Rng& rng, Rgb* out) const {
+    if (!(segment.length > 0.0f)) {
+        std::fill(out, out + count, Rgb(0.0f));
+        return;
+    }
+    constexpr size_t P = kKernelPadding;
+    for (size_t first = 0; first < count; first += P) {
+        const size_t n = std::min(P, count - first);
+        const Vrl* batch[P];
+        Rgb fluxes[P];
+        Rng* rngs[P];
+        for (size_t j = 0; j < n; ++j) {
+            batch[j] = &vrls[size_t(indices[first + j])];
+            fluxes[j] = batch[j]->flux;
+            rngs[j] = &rng;
+        }
+        evaluateFew(batch, fluxes, rngs, n, segment, out + first);
+    }
+}
+
 void VrlEstimator::contributions(const Query* queries, size_t count, const CameraSegment& segment, uint64_t streamKey,
                                  Rgb* result) const {
     if (!(segment.length > 0.0f)) {

@@ -78,6 +78,12 @@ public:
     void contributions(const Query* queries, size_t count, const CameraSegment& segment, uint64_t streamKey,
                        Rgb* out) const;
 
+    // contribution(vrls[indices[k]], segment, rng) for k < count into out[k], in SIMD
+    // lanes, every number drawn from the one `rng`: batch by batch of lanes, each
+    // sample lane by lane (the stochastic cut's drawn VRLs).
+    void contributions(const Vrl* vrls, const int32_t* indices, size_t count, const CameraSegment& segment, Rng& rng,
+                       Rgb* out) const;
+
     // The plain VRL method: the sum of contribution() over every VRL of `lanes`,
     // VRL k with vrlStream(streamKey, k), evaluated in SIMD lanes (no allocation
     // unless samplesPerVrl > 1).

@@ -142,8 +142,8 @@ TEST(StochasticCut, EveryContributingVrlIsReachableAndProbabilitiesSumToTheCutSi
             for (int q = 0; q < 24; ++q) {
                 const CameraSegment segment = randomSegment(tree, rng, q % 4);
                 const auto p = stochasticLeafProbabilities(
-                    tree, cutSize, [&](int32_t n) { return importance.segment(n, segment); });
-                const auto cut = stochasticCut(tree, cutSize, [&](int32_t n) { return importance.segment(n, segment); });
+                    tree, cutSize, [&, q = importance.prepare(segment)](int32_t n) { return importance.children(n, q); });
+                const auto cut = stochasticCut(tree, cutSize, [&, q = importance.prepare(segment)](int32_t n) { return importance.children(n, q); });
                 double sum = 0.0;
                 for (size_t k = 0; k < p.size(); ++k) {
                     sum += p[k];
@@ -167,7 +167,7 @@ TEST(StochasticCut, EveryContributingVrlIsReachableAndProbabilitiesSumToTheCutSi
                 const auto x = randomSurfacePoint(*scene, rng);
                 if (!x) continue;
                 const auto ps = stochasticLeafProbabilities(
-                    tree, cutSize, [&](int32_t n) { return importance.surface(n, *x); });
+                    tree, cutSize, [&, q = importance.prepare(*x)](int32_t n) { return importance.children(n, q); });
                 sum = 0.0;
                 for (size_t k = 0; k < ps.size(); ++k) {
                     sum += ps[k];
@@ -180,7 +180,7 @@ TEST(StochasticCut, EveryContributingVrlIsReachableAndProbabilitiesSumToTheCutSi
                             << m.name << " surface point " << q << " VRL " << k;
                     }
                 }
-                const auto cutS = stochasticCut(tree, cutSize, [&](int32_t n) { return importance.surface(n, *x); });
+                const auto cutS = stochasticCut(tree, cutSize, [&, q = importance.prepare(*x)](int32_t n) { return importance.children(n, q); });
                 EXPECT_NEAR(sum, double(cutS.size()), 1e-9 * double(cutS.size())) << m.name << " surface " << q;
                 ++queries;
             }
