@@ -63,6 +63,7 @@ class Scene;
 class VrlImportance {
 public:
     static constexpr float kDefaultMinimumDistanceFraction = 0.05f;
+    static constexpr size_t kBytesPerInnerNode = 64;  // sizeof(Pair): the memory it adds per VRL
 
     VrlImportance(const Scene& scene, const LightTree& tree,
                   float minimumDistanceFraction = kDefaultMinimumDistanceFraction);
@@ -99,7 +100,7 @@ private:
     struct alignas(64) Pair {
         Child child[2];
     };
-    static_assert(sizeof(Pair) == 64);
+    static_assert(sizeof(Pair) == kBytesPerInnerNode);
 
     int32_t nodeOf(const Child& c) const { return c.packed & indexMask_; }
     int mediumOf(const Child& c) const { return int(uint32_t(c.packed) >> indexBits_) - 1; }

@@ -27,8 +27,10 @@ public:
     KernelVrls from(size_t first) const;
     size_t memoryBytes() const { return floats_.capacity() * sizeof(float) + media_.capacity() * sizeof(int32_t); }
 
+    static constexpr size_t kBytesPerVrl = 11 * sizeof(float) + sizeof(int32_t);  // kArrays floats and a medium
     // The arrays of KernelVrls, in order; `write` fills entry k of each.
     enum Array { kOriginX, kOriginY, kOriginZ, kDirectionX, kDirectionY, kDirectionZ, kLength, kG, kFluxR, kFluxG, kFluxB, kArrays };
+    static_assert(kBytesPerVrl == kArrays * sizeof(float) + sizeof(int32_t));
     static void write(const Vrl& vrl, const Scene& scene, float* const arrays[kArrays], int32_t* media, size_t k);
     static KernelVrls view(const float* const arrays[kArrays], const int32_t* media);
 
