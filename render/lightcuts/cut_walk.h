@@ -8,6 +8,24 @@
 //   Rgb  leaf(int32_t node)                       exact estimate of a leaf
 //   bool bound(int32_t node, Rgb& bound)          false: the query crosses the node
 //   Rgb  estimate(int32_t node)                   the node's representative estimate
+//
+// Contract the walk relies on (true of every visitor in render/lightcuts/): a
+// node's estimate is its representative's estimate with the representative's
+// flux replaced by the node's flux Phi(node) (clusterFlux; a leaf: its VRL's
+// flux), drawn from the representative's own random stream, and it is linear in
+// that flux channel by channel. A refined node's representative is one of its
+// children's (LightTree validates it), so that child's estimate is the parent's
+// times Phi(child) / Phi(parent), channel by channel: the walk inherits it
+// instead of evaluating it again (Walter et al. 2005, Sec. 4.1). Only the other
+// child is evaluated, up to float rounding the same value it had before.
+//
+// Batched refinement: the node with the largest bound is refined, and with it
+// the next ones of the heap whose bounds also exceed the threshold of the total
+// before this step (kRefineBatch at most), so that one kernel call estimates
+// several new representatives in its lanes. The sequential walk would refine
+// those nodes too unless the total grew past their bounds' threshold in the
+// meantime; the batch can therefore only end with a few more refined nodes (a
+// finer cut, never a coarser one).
 #pragma once
 
 #include "render/core/rgb.h"
@@ -30,9 +48,16 @@ struct CutScratch {
         bool operator<(const CutNode& o) const { return bound != o.bound ? bound < o.bound : node > o.node; }
     };
     std::vector<CutNode> heap;      // a max-heap (std::push_heap) on bound
-    std::vector<int32_t> pending;   // nodes to add to the cut (children of refined nodes)
+    struct Pending {
+        int32_t node;
+        int32_t parent;  // the refined parent whose estimate it may inherit; -1: none (root, crossed parent)
+        Rgb parentEstimate;
+    };
+    std::vector<Pending> pending;   // nodes to add to the cut (children of refined nodes)
+    std::vector<CutNode> added;     // nodes with an estimate, to push on the heap
     std::vector<int32_t> queued;    // nodes to estimate, in one batch
-    std::vector<Rgb> bounds, estimates;
+    std::vector<Rgb> bounds, estimates;  // of the queued nodes
+    std::vector<Rgb> addedBounds;       // of the added (inherited) nodes
     bool inUse = false;
 };
 
@@ -45,6 +70,10 @@ struct CutScratch {
 // (leaf() for leaves, estimate() for the others, of `count` nodes at once): the
 // walk then estimates the nodes a refinement adds (both children, and the
 // children of crossed nodes) in one call, so that the VRL kernel fills lanes.
+// Nodes refined together at most (see "Batched refinement" above): the cuts'
+// kernel call has four lanes.
+inline constexpr int kRefineBatch = 4;
+
 template <class Visitor>
 Rgb walkCut(const LightTree& tree, const CutSettings& settings, CutStatistics& statistics, Visitor&& visitor,
             float otherLuminance = 0.0f) {
@@ -59,22 +88,53 @@ Rgb walkCut(const LightTree& tree, const CutSettings& settings, CutStatistics& s
     auto& heap = scratch.heap;
     auto& pending = scratch.pending;
     auto& queued = scratch.queued;
+    auto& added = scratch.added;
     heap.clear(), pending.clear(), queued.clear(), scratch.bounds.clear();
     Rgb total(0.0f);
     uint32_t leavesInCut = 0;
     const auto& nodes = tree.nodes();
+    const auto flux = [&](int32_t i) -> const Rgb& {
+        const LightTreeNode& n = nodes[size_t(i)];
+        return n.isLeaf() ? tree.vrls()[n.representative].flux : n.clusterFlux;
+    };
+    const auto inherit = [&](const Rgb& e, int32_t parent, int32_t child) {
+        const Rgb& from = flux(parent);
+        const Rgb& to = flux(child);
+        return Rgb(from.x > 0.0f ? e.x * (to.x / from.x) : 0.0f, from.y > 0.0f ? e.y * (to.y / from.y) : 0.0f,
+                   from.z > 0.0f ? e.z * (to.z / from.z) : 0.0f);
+    };
+    // Adds a node with its estimate and bound to the cut.
+    const auto addToCut = [&](int32_t i, const Rgb& e, const Rgb& b) {
+        total += e;
+        ++statistics.evaluated;
+        if (nodes[i].isLeaf()) {
+            ++leavesInCut;
+            return;
+        }
+        ++statistics.boundedEstimates;
+        if (e.x > b.x || e.y > b.y || e.z > b.z) ++statistics.boundExceeded;
+        const float key = luminance(b);
+        heap.push_back({key >= 0.0f ? key : std::numeric_limits<float>::infinity(), i, e});  // NaN: refine
+        std::push_heap(heap.begin(), heap.end());
+    };
     // Adds the nodes in `pending` (and, for crossed nodes, their children) to the cut.
     const auto addPending = [&] {
-        queued.clear(), scratch.bounds.clear();
+        queued.clear(), scratch.bounds.clear(), added.clear(), scratch.addedBounds.clear();
         while (!pending.empty()) {
-            const int32_t i = pending.back();
+            const CutScratch::Pending p = pending.back();
             pending.pop_back();
+            const int32_t i = p.node;
             const LightTreeNode& node = nodes[i];
             Rgb b(0.0f);
             if (!node.isLeaf() && !visitor.bound(i, b)) {  // infinite bound: refine without estimating
                 ++statistics.intersected;
-                pending.push_back(node.left);
-                pending.push_back(node.right);
+                pending.push_back({node.left, -1, Rgb(0.0f)});
+                pending.push_back({node.right, -1, Rgb(0.0f)});
+                continue;
+            }
+            if (p.parent >= 0 && node.representative == nodes[p.parent].representative) {
+                added.push_back({0.0f, i, inherit(p.parentEstimate, p.parent, i)});
+                scratch.addedBounds.push_back(b);
                 continue;
             }
             queued.push_back(i);
@@ -87,34 +147,24 @@ Rgb walkCut(const LightTree& tree, const CutSettings& settings, CutStatistics& s
             for (size_t k = 0; k < queued.size(); ++k)
                 scratch.estimates[k] = nodes[queued[k]].isLeaf() ? visitor.leaf(queued[k]) : visitor.estimate(queued[k]);
         }
-        for (size_t k = 0; k < queued.size(); ++k) {
-            const int32_t i = queued[k];
-            const Rgb& e = scratch.estimates[k];
-            total += e;
-            ++statistics.evaluated;
-            if (nodes[i].isLeaf()) {
-                ++leavesInCut;
-                continue;
-            }
-            const Rgb& b = scratch.bounds[k];
-            ++statistics.boundedEstimates;
-            if (e.x > b.x || e.y > b.y || e.z > b.z) ++statistics.boundExceeded;
-            const float key = luminance(b);
-            heap.push_back({key >= 0.0f ? key : std::numeric_limits<float>::infinity(), i, e});  // NaN: refine
-            std::push_heap(heap.begin(), heap.end());
-        }
+        for (size_t a = 0; a < added.size(); ++a) addToCut(added[a].node, added[a].estimate, scratch.addedBounds[a]);
+        for (size_t q = 0; q < queued.size(); ++q) addToCut(queued[q], scratch.estimates[q], scratch.bounds[q]);
     };
-    pending.push_back(tree.root());
+    pending.push_back({tree.root(), -1, Rgb(0.0f)});
     addPending();
     while (!heap.empty()) {
-        const CutScratch::CutNode top = heap.front();
-        if (top.bound <= settings.errorThreshold * (std::max(0.0f, luminance(total)) + otherLuminance)) break;
-        if (heap.size() + leavesInCut >= settings.maxCutSize) break;
-        std::pop_heap(heap.begin(), heap.end());
-        heap.pop_back();
-        total -= top.estimate;
-        pending.push_back(nodes[top.node].right);
-        pending.push_back(nodes[top.node].left);
+        const float threshold = settings.errorThreshold * (std::max(0.0f, luminance(total)) + otherLuminance);
+        for (int refined = 0; refined < kRefineBatch && !heap.empty(); ++refined) {
+            const CutScratch::CutNode top = heap.front();
+            if (top.bound <= threshold) break;
+            if (heap.size() + leavesInCut + 2 * size_t(refined) >= settings.maxCutSize) break;  // the cut after `refined` refinements
+            std::pop_heap(heap.begin(), heap.end());
+            heap.pop_back();
+            total -= top.estimate;
+            pending.push_back({nodes[top.node].right, top.node, top.estimate});
+            pending.push_back({nodes[top.node].left, top.node, top.estimate});
+        }
+        if (pending.empty()) break;
         addPending();
     }
     statistics.cutSize += uint32_t(heap.size()) + leavesInCut;
