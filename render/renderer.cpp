@@ -3,6 +3,8 @@
 #include "render/core/timing.h"
 #include "render/integrators/path_tracer.h"
 #include "render/integrators/transport_integrator.h"
+#include "render/lightcuts/direction_cone.h"
+#include "render/lightcuts/leaf_segments.h"
 #include "render/lightcuts/vrl_importance.h"
 #include "render/vrl/light_tracer.h"
 #include "render/vrl/vrl_lanes.h"
@@ -162,9 +164,14 @@ uint64_t estimateLightMemoryBytes(const RenderSettings& settings) {
     // build scratch (packed boxes, freed once it is built).
     double perLight = 2.0 * sizeof(Vrl);
     if (usesLightTree(settings.method)) perLight += 2.0 * sizeof(LightTreeNode) + double(LightTree::buildScratchBytesPerVrl());
-    // What the shading adds per light: the stochastic importance's record per inner
-    // node, plain VRLs' structure-of-arrays copy.
-    if (settings.method == RenderMethod::VrlStochastic) perLight += double(VrlImportance::kBytesPerInnerNode);
+    // What the shading adds per light: the deterministic cut's direction cones (an
+    // HG medium only; counted always, the scene is not read here) and leaf
+    // segments, the stochastic importance's record per inner node, plain VRLs'
+    // structure-of-arrays copy.
+    if (settings.method == RenderMethod::VrlLightcuts)
+        perLight += double(DirectionCones::kBytesPerVrl + LeafSegments::kBytesPerVrl);
+    if (settings.method == RenderMethod::VrlStochastic)
+        perLight += double(VrlImportance::kBytesPerInnerNode);
     if (settings.method == RenderMethod::Vrl) perLight += double(VrlLanes::kBytesPerVrl);
     const double bytes = perLight * double(settings.vrlCount) * double(std::max(1, settings.vrlSets));
     return bytes >= 1.8e19 ? ~uint64_t(0) : uint64_t(bytes);

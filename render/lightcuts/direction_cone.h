@@ -54,6 +54,7 @@ public:
     explicit DirectionCones(const LightTree& tree);
 
     const DirectionCone& operator[](int32_t node) const { return cones_[size_t(node)]; }
+    static constexpr size_t kBytesPerVrl = 2 * sizeof(DirectionCone);  // a cone per node, two nodes per VRL
     // `shared` if given, else cones built into `owned`: what a bound keeps a pointer to.
     static const DirectionCones* shareOrBuild(const DirectionCones* shared, const LightTree& tree,
                                               std::unique_ptr<DirectionCones>& owned) {

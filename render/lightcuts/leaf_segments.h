@@ -27,6 +27,8 @@ public:
     // `node`: distanceLineSegment's minimum, computed in SIMD lanes (segment_distances.h).
     double minDistanceToLine(int32_t node, const Vec3& origin, const Vec3& direction) const;
     size_t memoryBytes() const;
+    // Per VRL: six float coordinates and a first-leaf index for each of its two nodes.
+    static constexpr size_t kBytesPerVrl = 6 * sizeof(float) + 2 * sizeof(uint32_t);
     // `shared` when given, else a new one kept in `owned`.
     static const LeafSegments* shareOrBuild(const LeafSegments* shared, const LightTree& tree,
                                             std::unique_ptr<LeafSegments>& owned) {

@@ -134,12 +134,13 @@ TEST(VrlSets, OnlyVrlStochasticTakesSeveralSetsAndTheCountIsBounded) {
     EXPECT_NO_THROW(validateRenderSettings(stochasticSettings(kMaxVrlSets, 1)));
     // The memory estimate (checked before any light is traced) grows with the sets.
     EXPECT_EQ(estimateLightMemoryBytes(stochasticSettings(4, 1)), 4 * estimateLightMemoryBytes(stochasticSettings(1, 1)));
-    // It counts the stochastic importance's 64-byte record per inner node.
+    // It counts what each cut adds per VRL: the stochastic importance's 64-byte record
+    // per inner node; the deterministic cut's cones (32 B) and leaf segments (32 B).
     RenderSettings deterministic = stochasticSettings(1, 1);
     deterministic.method = RenderMethod::VrlLightcuts;
     deterministic.vrlSets = 1;
     EXPECT_EQ(estimateLightMemoryBytes(stochasticSettings(1, 1)),
-              estimateLightMemoryBytes(deterministic) + 64 * uint64_t(deterministic.vrlCount));
+              estimateLightMemoryBytes(deterministic) + (64 - 32 - 32) * uint64_t(deterministic.vrlCount));
 }
 
 TEST(VrlSets, ShaderRefusesLightsOfAnotherSetCount) {
