@@ -29,7 +29,7 @@ import sys
 RESULTS_COLUMNS = [
     "scene", "method", "setting", "vrls", "spp", "error_threshold",
     "seconds", "rmse", "rel_rmse", "smape", "mean_eval", "mean_inter",
-    "mean_cut", "mean_ratio",
+    "mean_cut", "mean_ratio", "cut_size", "ref_noise_rmse", "below_noise",
 ]
 SPEEDUP_COLUMNS = [
     "scene", "kind", "n", "brute_seconds_per_pixel",
@@ -49,8 +49,10 @@ METHOD_STYLE = {
     "vrl": ("VRL (brute force)", "#1f77b4", "o"),
     "vrl-lightcuts": ("VRL Lightcuts", "#d62728", "^"),
     "vpl-lightcuts": ("VPL Lightcuts", "#2ca02c", "v"),
+    "vrl-stochastic": ("Stochastic VRL Lightcuts", "#9467bd", "D"),
 }
-METHOD_ORDER = ["path", "vrl", "vrl-lightcuts", "vpl-lightcuts"]
+METHOD_ORDER = ["path", "vrl", "vrl-lightcuts", "vrl-stochastic",
+                "vpl-lightcuts"]
 THRESHOLD_METHODS = ("vrl-lightcuts", "vpl-lightcuts")
 # Colours for methods not listed above (stable per method name).
 EXTRA_COLOURS = ["#9467bd", "#8c564b", "#e377c2", "#bcbd22", "#17becf",
@@ -208,7 +210,13 @@ def build_curves(rows):
         label, colour, marker = method_style(method, build_curves.extra)
         method_rows = by_method[method]
         groups = [(None, method_rows)]
-        if method in THRESHOLD_METHODS:
+        if method == "vrl-stochastic":
+            sizes = {}
+            for row in method_rows:
+                sizes.setdefault(row.get("cut_size", ""), []).append(row)
+            groups = sorted(sizes.items(),
+                            key=lambda item: to_float(item[0]) or 0.0)
+        elif method in THRESHOLD_METHODS:
             thresholds = {}
             for row in method_rows:
                 key = format_threshold(row["error_threshold"])
@@ -221,8 +229,12 @@ def build_curves(rows):
                 groups = sorted(thresholds.items(), key=threshold_key)
         linestyles = ["-", "--", ":", "-."]
         for index, (threshold, group) in enumerate(groups):
-            text = label if threshold is None else (
-                "%s (\u03b5=%s)" % (label, threshold))
+            if threshold is None:
+                text = label
+            elif method == "vrl-stochastic":
+                text = "%s (K=%s)" % (label, threshold)
+            else:
+                text = "%s (\u03b5=%s)" % (label, threshold)
             style = linestyles[index % len(linestyles)]
             group = sorted(group, key=lambda r: (
                 to_float(r["seconds"]) if positive_finite(
@@ -261,6 +273,18 @@ def plot_scene(plt, scene, rows, out_dir):
             drawn += 1
             if text not in labels:
                 labels.append(text)
+                handles.append(line)
+        # The noise rule's floor: 3x the reference's own RMSE (below it, errors
+        # cannot be told from the reference's noise).
+        noise = [to_float(r.get("ref_noise_rmse")) for r in rows]
+        noise = [v for v in noise if positive_finite(v)]
+        if column == "rmse" and noise:
+            floor = 3.0 * noise[0]
+            line = ax.axhline(floor, color="0.5", linestyle=":",
+                              linewidth=1.0,
+                              label="3x reference noise (noise rule)")
+            if line.get_label() not in labels:
+                labels.append(line.get_label())
                 handles.append(line)
         ax.set_xscale("log")
         ax.set_yscale("log")

@@ -29,6 +29,10 @@ std::vector<MethodRun> sweep(bool quick) {
         runs.push_back({RenderMethod::VrlLightcuts, 10000, 64, 0.1f});
         runs.push_back({RenderMethod::VplLightcuts, 3000, 16, 0.02f});
         runs.push_back({RenderMethod::VplLightcuts, 10000, 64, 0.02f});
+        for (const uint32_t k : {8u, 32u}) {
+            runs.push_back({RenderMethod::VrlStochastic, 3000, 16, 0.02f, k});
+            runs.push_back({RenderMethod::VrlStochastic, 10000, 64, 0.02f, k});
+        }
         return runs;
     }
     for (int spp : {16, 64, 256, 1024}) runs.push_back({RenderMethod::Path, 0, spp});
@@ -39,6 +43,8 @@ std::vector<MethodRun> sweep(bool quick) {
     for (const auto& [n, spp] : many)
         if (n < 1000000) runs.push_back({RenderMethod::VrlLightcuts, n, spp, 0.1f});
     for (const auto& [n, spp] : many) runs.push_back({RenderMethod::VplLightcuts, n, spp, 0.02f});
+    for (const uint32_t k : {8u, 32u})
+        for (const auto& [n, spp] : many) runs.push_back({RenderMethod::VrlStochastic, n, spp, 0.02f, k});
     return runs;
 }
 
@@ -50,10 +56,23 @@ std::string MethodRun::label() const {
         std::snprintf(buffer, sizeof buffer, "%d spp", spp);
     } else if (!usesLightTree(method)) {
         std::snprintf(buffer, sizeof buffer, "N=%s %d spp", compactCount(lights).c_str(), spp);
+    } else if (method == RenderMethod::VrlStochastic) {
+        std::snprintf(buffer, sizeof buffer, "N=%s K=%u %d spp", compactCount(lights).c_str(), cutSize, spp);
     } else {
         std::snprintf(buffer, sizeof buffer, "N=%s e=%g %d spp", compactCount(lights).c_str(), double(errorThreshold), spp);
     }
     return buffer;
+}
+
+std::string MethodRun::curve() const {
+    std::string name(methodName(method));
+    if (method == RenderMethod::VrlStochastic) return name + " K=" + std::to_string(cutSize);
+    if (usesLightTree(method)) {
+        char buffer[32];
+        std::snprintf(buffer, sizeof buffer, " e=%g", double(errorThreshold));
+        return name + buffer;
+    }
+    return name;
 }
 
 std::vector<BenchmarkScene> benchmarkScenes(bool quick, const std::filesystem::path& repository,
@@ -66,7 +85,7 @@ std::vector<BenchmarkScene> benchmarkScenes(bool quick, const std::filesystem::p
         s.file = repository / "scenes" / "bathroom-spots.xml";
         s.defines = std::move(defines);
         if (quick) {
-            s.width = 32, s.height = 24, s.referenceSpp = 1024;
+            s.width = 32, s.height = 24, s.referenceSpp = 16384;
             s.tableLights = 10000;
             s.speedupLights = {1000, 10000};
         } else {

@@ -14,13 +14,18 @@
 namespace vrl::report {
 
 // One render of the sweep. `lights`: VRLs or VPLs (0 for the path tracer);
-// `spp`: samples per pixel (path tracer; parts (a)-(c) of the virtual-light methods).
+// `spp`: samples per pixel (path tracer; parts (a)-(c) of the virtual-light
+// methods; for stochastic VRL Lightcuts also parts (c) and (d): each sample
+// draws new cuts); `cutSize`: stochastic VRL Lightcuts' K (0 for the others).
 struct MethodRun {
     RenderMethod method = RenderMethod::Path;
     uint64_t lights = 0;
     int spp = 1;
     float errorThreshold = 0.02f;
+    uint32_t cutSize = 0;
     std::string label() const;  // no commas (a CSV field)
+    // The curve the run belongs to: method, and threshold or cut size where a method has several.
+    std::string curve() const;
 };
 
 struct BenchmarkScene {

@@ -18,13 +18,29 @@ for f in results.csv speedup.csv summary.md error-time-bathroom.png speedup.png 
 done
 head -1 "$out/results.csv" | grep -q '^scene,method,setting,vrls,spp,error_threshold,seconds,rmse,rel_rmse,smape' \
     || fail "results.csv header"
-for m in path vrl vrl-lightcuts vpl-lightcuts; do
+for m in path vrl vrl-lightcuts vrl-stochastic vpl-lightcuts; do
     grep -q "^bathroom,$m," "$out/results.csv" || fail "no $m row in results.csv"
 done
-# Every row has 14 fields and finite, non-negative errors.
-awk -F, 'NR > 1 { if (NF != 14) { print "bad field count: " $0; exit 1 }
+# Every row has 17 fields and finite, non-negative errors.
+awk -F, 'NR > 1 { if (NF != 17) { print "bad field count: " $0; exit 1 }
                   for (i = 7; i <= 10; ++i) if ($i !~ /^[0-9.e+-]+$/ || $i < 0) { print "bad number: " $0; exit 1 } }' \
     "$out/results.csv" || fail "results.csv rows"
+head -1 "$out/results.csv" | grep -q ',cut_size,ref_noise_rmse,below_noise$' || fail "results.csv noise columns"
+# Stochastic runs at two cut sizes.
+[ "$(awk -F, '$2 == "vrl-stochastic" { print $15 }' "$out/results.csv" | sort -u | wc -l)" -eq 2 ] \
+    || fail "vrl-stochastic should run at two cut sizes"
+# The noise rule: below_noise is 1 exactly where RMSE < 3 x the reference's noise RMSE,
+# and the reference's noise is measured (positive).
+awk -F, 'NR > 1 { if (!($16 > 0)) { print "no reference noise: " $0; exit 1 }
+                  expect = ($8 < 3 * $16) ? 1 : 0
+                  if ($17 != expect) { print "noise rule: " $0; exit 1 } }' "$out/results.csv" \
+    || fail "below_noise does not follow the noise rule"
+grep -q "Noise rule" "$out/summary.md" || fail "summary.md does not state the noise rule"
+# A VRL Lightcuts point below the noise floor has no ratio: every cell after its time is ‡.
+awk -F'|' '/^\| VRL Lightcuts point/ { table = 1; next }
+           table && !/^\|/ { table = 0 }
+           table && $2 ~ /‡/ { for (i = 4; i < NF; ++i) if ($i !~ /^ *‡ *$/) { print "ratio below noise: " $0; exit 1 } }' \
+    "$out/summary.md" || fail "a ratio was given for a run below the noise floor"
 [ "$(grep -c '^bathroom,' "$out/speedup.csv")" -ge 4 ] || fail "speedup.csv rows"
 for heading in "## bathroom" "## Table 1" "## Figure 4" "Equal-time error ratios"; do
     grep -q "$heading" "$out/summary.md" || fail "summary.md lacks '$heading'"
