@@ -298,7 +298,10 @@ def plot_scene(plt, scene, rows, out_dir):
                     va="center", transform=ax.transAxes, color="0.4")
         ax.grid(True, which="major", alpha=0.5)
         ax.grid(True, which="minor", alpha=0.15)
-    fig.suptitle("%s: error against time" % scene)
+    if rows and rows[0].get("part") == "multiple":
+        fig.suptitle("%s, part (d) alone: error against time" % rows[0]["scene"])
+    else:
+        fig.suptitle("%s: error against time" % scene)
     bottom = 0.0
     if handles:
         # One shared legend below the panels, so it never hides data.
@@ -408,9 +411,11 @@ def main(argv=None):
         print("note: %s has no data rows; no error-time plots"
               % args.results, file=sys.stderr)
 
+    # Part (d) alone (part = multiple) gets its own plot, error-time-<scene>-d.png.
     by_scene = {}
     for row in results:
-        by_scene.setdefault(row["scene"], []).append(row)
+        key = row["scene"] + ("-d" if row.get("part") == "multiple" else "")
+        by_scene.setdefault(key, []).append(row)
 
     used_names = {}
     for scene, rows in by_scene.items():

@@ -48,6 +48,35 @@ std::vector<MethodRun> sweep(bool quick) {
     return runs;
 }
 
+// Part (d) alone: the virtual-light methods with the other parts off. Plain VRLs,
+// deterministic cuts and VPL Lightcuts at one sample per pixel (rays through pixel
+// centres: more samples would only redraw the estimators' numbers); stochastic
+// cuts draw new cuts per sample, so their spp grow along the curve.
+std::vector<MethodRun> multipleSweep(bool quick) {
+    std::vector<MethodRun> runs;
+    const auto add = [&](MethodRun r) {
+        r.multipleOnly = true;
+        runs.push_back(r);
+    };
+    if (quick) {
+        for (uint64_t n : {1000, 3000}) add({RenderMethod::Vrl, n, 1});
+        for (uint64_t n : {3000, 10000}) add({RenderMethod::VrlLightcuts, n, 1, 0.02f});
+        for (uint64_t n : {3000, 10000}) add({RenderMethod::VplLightcuts, n, 1, 0.02f});
+        for (const uint32_t k : {8u, 32u})
+            for (const auto& [n, spp] : {std::pair<uint64_t, int>{3000, 2}, {10000, 8}})
+                add({RenderMethod::VrlStochastic, n, spp, 0.02f, k});
+        return runs;
+    }
+    for (uint64_t n : {1000, 4000, 16000, 64000}) add({RenderMethod::Vrl, n, 1});
+    for (uint64_t n : {10000, 100000, 1000000}) add({RenderMethod::VrlLightcuts, n, 1, 0.02f});
+    for (uint64_t n : {10000, 100000}) add({RenderMethod::VrlLightcuts, n, 1, 0.1f});
+    for (uint64_t n : {10000, 100000, 1000000}) add({RenderMethod::VplLightcuts, n, 1, 0.02f});
+    for (const uint32_t k : {8u, 32u})
+        for (const auto& [n, spp] : {std::pair<uint64_t, int>{10000, 4}, {100000, 16}, {1000000, 64}})
+            add({RenderMethod::VrlStochastic, n, spp, 0.02f, k});
+    return runs;
+}
+
 }  // namespace
 
 std::string MethodRun::label() const {
@@ -65,7 +94,7 @@ std::string MethodRun::label() const {
 }
 
 std::string MethodRun::curve() const {
-    std::string name(methodName(method));
+    std::string name = std::string(multipleOnly ? "(d) " : "") + std::string(methodName(method));
     if (method == RenderMethod::VrlStochastic) return name + " K=" + std::to_string(cutSize);
     if (usesLightTree(method)) {
         char buffer[32];
@@ -86,6 +115,7 @@ std::vector<BenchmarkScene> benchmarkScenes(bool quick, const std::filesystem::p
         s.defines = std::move(defines);
         if (quick) {
             s.width = 32, s.height = 24, s.referenceSpp = 16384;
+            s.partReferenceVrls = 10000, s.partReferenceSets = 8, s.partReferenceSpp = 256;
             s.tableLights = 10000;
             s.speedupLights = {1000, 10000};
         } else {
@@ -94,6 +124,7 @@ std::vector<BenchmarkScene> benchmarkScenes(bool quick, const std::filesystem::p
             s.speedupLights = {1000, 10000, 100000, 1000000};
         }
         s.runs = sweep(quick);
+        for (const auto& r : multipleSweep(quick)) s.runs.push_back(r);
         return s;
     };
     scenes.push_back(own("bathroom", "our own scene in the spirit of the paper's BATHROOM: two spot lights in an "
@@ -119,6 +150,7 @@ std::vector<BenchmarkScene> benchmarkScenes(bool quick, const std::filesystem::p
         s.medium = std::move(medium);
         s.width = width, s.height = height, s.referenceSpp = referenceSpp;
         s.runs = sweep(false);
+        for (const auto& r : multipleSweep(false)) s.runs.push_back(r);
         s.tableLights = 100000;
         return s;
     };

@@ -23,6 +23,7 @@ struct MethodRun {
     int spp = 1;
     float errorThreshold = 0.02f;
     uint32_t cutSize = 0;
+    bool multipleOnly = false;  // part (d) alone (the paper's Figure 3 comparison), against the (d) reference
     std::string label() const;  // no commas (a CSV field)
     // The curve the run belongs to: method, and threshold or cut size where a method has several.
     std::string curve() const;
@@ -38,7 +39,12 @@ struct BenchmarkScene {
     int width = 64, height = 48;
     int maxDepth = 12;              // the paper's "maximum path length is 12 for all the scenes"
     int referenceSpp = 256;         // path tracer; two independent halves of referenceSpp / 2
-    std::vector<MethodRun> runs;
+    // Part (d)'s reference: vrl-stochastic (K = 32) over independent VRL sets, so that it
+    // converges to the true transport; per half: partReferenceSets sets of
+    // partReferenceVrls VRLs, partReferenceSpp samples per pixel.
+    uint64_t partReferenceVrls = 100000;
+    int partReferenceSets = 16, partReferenceSpp = 256;
+    std::vector<MethodRun> runs;    // the whole image, then part (d) alone (multipleOnly)
     uint64_t tableLights = 100000;  // N of the Table 1 / Figure 6 runs (both Lightcuts at the default threshold)
     std::vector<uint64_t> speedupLights;  // N of the Figure 4 speed-up measurement
 };

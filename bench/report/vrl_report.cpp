@@ -49,6 +49,8 @@ using Clock = std::chrono::steady_clock;
 
 struct Options {
     fs::path out = "report";
+    bool buildReferences = false;  // --references: build the missing references, then stop
+    fs::path references = fs::path(VRL_SOURCE_DIR) / "bench" / "references";  // --quick: OUT/cache
     fs::path shared = fs::path(VRL_SOURCE_DIR).parent_path() / "shared" / "scenes";
     bool quick = false;
     std::vector<std::string> only;
@@ -79,7 +81,13 @@ struct SpeedupResult {
     double meanEval = 0.0, meanInter = 0.0;
 };
 
+// The two references of a scene: the whole image (path tracer) and part (d) alone
+// (stochastic VRL Lightcuts over many independent VRL sets).
+enum class ReferencePart { Image, Multiple };
+
 struct ReferenceInfo {
+    ReferencePart part = ReferencePart::Image;
+    std::string method;  // how it was made, for the summary
     int spp = 0;
     double seconds = 0.0;  // when rendered in this run or recorded in the cache
     bool cached = false;
@@ -139,38 +147,75 @@ RenderSettings settingsFor(const BenchmarkScene& s, const MethodRun& run, uint64
     settings.vrlCount = std::max<uint64_t>(1, run.lights);
     settings.cut.errorThreshold = run.errorThreshold;
     if (run.cutSize > 0) settings.cut.stochasticCutSize = run.cutSize;
+    if (run.multipleOnly) settings.transports = TransportSelection::parse("multiple");
     return settings;
 }
 
-// Renders (or loads) the reference: the mean of two independent path-traced halves.
-Image referenceImage(const BenchmarkScene& s, const Scene& scene, const fs::path& cacheDir, const Log& log,
-                     ReferenceInfo& info) {
-    const int half = std::max(1, s.referenceSpp / 2);
-    const std::string key = "path spp=" + std::to_string(half) + "x2 maxDepth=" + std::to_string(s.maxDepth) +
-                            " size=" + std::to_string(s.width) + "x" + std::to_string(s.height) + " medium=" + s.medium +
-                            " version=" + VRL_VERSION;
-    const fs::path file = cacheDir / (s.name + "-reference-" + hashSceneAndSettings(s, key) + ".exr");
-    info.spp = 2 * half;
+// The settings of one half of a reference.
+RenderSettings referenceSettings(const BenchmarkScene& s, ReferencePart part, uint64_t half) {
+    if (part == ReferencePart::Image)
+        return settingsFor(s, MethodRun{RenderMethod::Path, 0, std::max(1, s.referenceSpp / 2)}, 1000003 + half);
+    RenderSettings settings =
+        settingsFor(s, MethodRun{RenderMethod::VrlStochastic, s.partReferenceVrls, s.partReferenceSpp, 0.02f, 32},
+                    2000003 + half);  // the seed also keys the halves' VRL sets: independent
+    settings.transports = TransportSelection::parse("multiple");
+    settings.vrlSets = s.partReferenceSets;
+    return settings;
+}
+
+std::string gitCommit() {
+    const std::string command = "git -C '" + std::string(VRL_SOURCE_DIR) + "' rev-parse --short HEAD 2>/dev/null";
+    std::string out;
+    if (FILE* pipe = popen(command.c_str(), "r")) {
+        char buffer[64];
+        while (std::fgets(buffer, sizeof buffer, pipe)) out += buffer;
+        pclose(pipe);
+    }
+    while (!out.empty() && (out.back() == '\n' || out.back() == ' ')) out.pop_back();
+    return out.empty() ? "unknown" : out;
+}
+
+// Renders (or loads) a reference: the mean of two independent halves, stored in
+// `dir` as half-float EXR (float where a value exceeds half's range) with its
+// halves, keyed by a hash of the scene's files, the settings and the method, and
+// a text file beside it with the settings, the code version and the estimated noise.
+Image referenceImage(const BenchmarkScene& s, const Scene& scene, ReferencePart part, const fs::path& dir,
+                     const Log& log, ReferenceInfo& info) {
+    const RenderSettings first = referenceSettings(s, part, 0);
+    const bool image = part == ReferencePart::Image;
+    const std::string what = image ? "reference" : "part (d) reference";
+    std::string key = image ? "path spp=" + std::to_string(first.samplesPerPixel) + "x2"
+                            : "vrl-stochastic transports=multiple K=32 vrls=" + std::to_string(first.vrlCount) +
+                                  " sets=" + std::to_string(first.vrlSets) + " spp=" +
+                                  std::to_string(first.samplesPerPixel) + "x2";
+    key += " maxDepth=" + std::to_string(s.maxDepth) + " size=" + std::to_string(s.width) + "x" +
+           std::to_string(s.height) + " medium=" + s.medium + " version=" + VRL_VERSION;
+    const fs::path file =
+        dir / (s.name + (image ? "-reference-" : "-reference-d-") + hashSceneAndSettings(s, key) + ".exr");
+    info.part = part;
+    info.method = image ? "path tracer, " + std::to_string(2 * first.samplesPerPixel) + " spp"
+                        : "stochastic VRL Lightcuts (K = 32), " + std::to_string(2 * first.vrlSets) + " VRL sets of " +
+                              std::to_string(first.vrlCount) + ", " + std::to_string(2 * first.samplesPerPixel) + " spp";
+    info.spp = 2 * first.samplesPerPixel;
     info.file = file;
     ImageSet set;
     if (fs::exists(file)) {
         set = readExr(file);
         info.cached = true;
         info.seconds = metadataNumber(set.metadata["vrl.report.seconds"]);
-        log.line("%s: reference from the cache (%s)", s.name.c_str(), file.filename().c_str());
+        log.line("%s: %s from the cache (%s)", s.name.c_str(), what.c_str(), file.filename().c_str());
     } else {
-        log.line("%s: rendering the reference, path tracer %d spp in two halves (%dx%d)...", s.name.c_str(), 2 * half,
+        log.line("%s: rendering the %s, %s in two halves (%dx%d)...", s.name.c_str(), what.c_str(), info.method.c_str(),
                  s.width, s.height);
         const auto start = Clock::now();
         std::vector<Image> halves;
         for (uint64_t h = 0; h < 2; ++h) {
-            MethodRun run{RenderMethod::Path, 0, half};
             int lastDecile = -1;
-            halves.push_back(render(scene, settingsFor(s, run, 1000003 + h), [&](const char*, double f) {
+            halves.push_back(render(scene, referenceSettings(s, part, h), [&](const char*, double f) {
                 const int decile = int(f * 10.0);
                 if (decile > lastDecile && decile % 2 == 0) {
                     lastDecile = decile;
-                    log.line("%s: reference half %d: %d%%", s.name.c_str(), int(h) + 1, decile * 10);
+                    log.line("%s: %s half %d: %d%%", s.name.c_str(), what.c_str(), int(h) + 1, decile * 10);
                 }
             }).image);
         }
@@ -183,22 +228,27 @@ Image referenceImage(const BenchmarkScene& s, const Scene& scene, const fs::path
         record.scene = s.file.string();
         record.defines = s.defines;
         record.medium = s.medium;
-        record.settings = settingsFor(s, MethodRun{RenderMethod::Path, 0, half}, 1000003);
-        record.settings.samplesPerPixel = 2 * half;  // the two halves together
+        record.settings = first;
+        record.settings.samplesPerPixel = 2 * first.samplesPerPixel;  // the two halves together
         record.statistics.seconds = info.seconds;
         record.run = {{"halves", int32_t(2)}};
         writeRenderMetadata(record, scene.camera(), set.metadata);
         set.metadata["vrl.report.key"] = key;
         set.metadata["vrl.report.seconds"] = info.seconds;
-        fs::create_directories(cacheDir);
-        writeExr(file, set);
-        log.line("%s: reference done in %.1f s -> %s", s.name.c_str(), info.seconds, file.string().c_str());
+        set.metadata["vrl.report.commit"] = gitCommit();
+        fs::create_directories(dir);
+        try {
+            writeExr(file, set, ExrPixels::Half);
+        } catch (const std::invalid_argument&) {  // a value beyond half's range
+            writeExr(file, set);
+        }
+        log.line("%s: %s done in %.1f s -> %s", s.name.c_str(), what.c_str(), info.seconds, file.string().c_str());
     }
     const Image* h1 = nullptr;
     const Image* h2 = nullptr;
-    for (const auto& [name, image] : set.layers) {
-        if (name == "half1") h1 = &image;
-        if (name == "half2") h2 = &image;
+    for (const auto& [name, layer] : set.layers) {
+        if (name == "half1") h1 = &layer;
+        if (name == "half2") h2 = &layer;
     }
     if (!h1 || !h2) throw std::runtime_error("cached reference " + file.string() + " lacks its halves; delete it");
     // The mean of two halves has half the variance of one: its RMSE against the
@@ -207,6 +257,13 @@ Image referenceImage(const BenchmarkScene& s, const Scene& scene, const fs::path
     info.noiseRmse = m.rmse / 2.0;
     info.noiseRelativeRmse = m.relativeRmse / 2.0;
     info.noiseSmape = m.smape / 2.0;  // SMAPE is not a variance; halving is only indicative
+    if (!info.cached) {  // the record beside it, for a reader of bench/references/
+        std::ofstream note(fs::path(file).replace_extension(".txt"));
+        note << what << " of " << s.name << "\nfile: " << file.filename().string() << "\nmethod: " << info.method
+             << "\nkey: " << key << "\ncommit: " << gitCommit() << "\nseconds: " << info.seconds
+             << "\nnoise (RMSE of the mean, from the halves): " << info.noiseRmse
+             << "\nnoise relative RMSE: " << info.noiseRelativeRmse << "\n";
+    }
     return set.image;
 }
 
@@ -307,7 +364,8 @@ std::vector<CurvePoint> curveOf(const std::vector<RunResult>& results, const std
     return cleanCurve(points);
 }
 
-std::string curveTitle(const std::string& curve) {
+std::string curveTitle(std::string curve) {
+    if (curve.rfind("(d) ", 0) == 0) return "(d) " + curveTitle(curve.substr(4));
     for (const RenderMethod m : kRenderMethods) {
         const std::string name(methodName(m));
         if (curve.rfind(name, 0) == 0 && (curve.size() == name.size() || curve[name.size()] == ' '))
@@ -318,12 +376,64 @@ std::string curveTitle(const std::string& curve) {
 
 struct SceneReport {
     BenchmarkScene scene;
-    ReferenceInfo reference;
+    ReferenceInfo reference, partReference;
     double loadSeconds = 0.0;
     std::string skipped;  // reason, if skipped
     std::map<RenderMethod, std::pair<double, double>> tableStats;  // method -> (#Eval, #Inter)
     std::vector<std::string> images;  // markdown image lines
 };
+
+// One part's comparison for a scene: its plot, every run's errors, and the ratios
+// of VRL Lightcuts (e = 0.02) against each other method's curve.
+void writeComparison(std::ostream& md, const std::vector<RunResult>& results, const std::string& name,
+                     bool multipleOnly) {
+    const std::string prefix = multipleOnly ? "(d) " : "";
+    std::vector<std::string> others = {"vrl", "vrl-stochastic K=8", "vrl-stochastic K=32", "vpl-lightcuts e=0.02"};
+    if (!multipleOnly) others.push_back("path");
+    for (auto& o : others) o = prefix + o;
+    const std::string recommended = prefix + "vrl-lightcuts e=0.02";
+    md << "![error against time](error-time-" << safeName(name) << (multipleOnly ? "-d" : "") << ".png)\n\n";
+    md << "| method | settings | time (s) | RMSE | RMSE / reference noise | rel. RMSE | SMAPE | mean ratio | #Eval | #Inter "
+          "|\n|---|---|---|---|---|---|---|---|---|---|\n";
+    for (const auto& r : results) {
+        if (r.scene != name || r.run.multipleOnly != multipleOnly) continue;
+        const bool cuts = usesLightTree(r.run.method);
+        md << "| " << methodTitle(r.run.method) << " | " << r.run.label() << " | " << fmt(r.seconds) << " | "
+           << fmt(r.metrics.rmse) << " | " << fmt(r.metrics.rmse / r.referenceNoiseRmse) << (r.belowNoise() ? " ‡" : "")
+           << " | " << fmt(r.metrics.relativeRmse) << " | " << fmt(r.metrics.smape) << " | "
+           << fmt(r.metrics.meanReference > 0 ? r.metrics.meanTest / r.metrics.meanReference : NAN) << " | "
+           << (cuts ? fmt(r.stats.meanEvaluated, 4) : "") << " | " << (cuts ? fmt(r.stats.meanIntersected, 4) : "")
+           << " |\n";
+    }
+    md << "\nEqual-time error ratios (the other method's error at VRL Lightcuts' time, divided by VRL Lightcuts' "
+          "error; > 1: VRL Lightcuts is better) and equal-error time ratios (the other method's time to reach VRL "
+          "Lightcuts' RMSE, divided by VRL Lightcuts' time; > 1: VRL Lightcuts is faster); '—' where the other "
+          "method's measured range (above the noise rule's floor) does not reach; ‡: below the noise rule's "
+          "floor, no ratio.\n\n";
+    md << "| VRL Lightcuts point | time (s) |";
+    for (const auto& m : others) md << " " << curveTitle(m) << ": RMSE × | SMAPE × | time × |";
+    md << "\n|---|---|";
+    for (size_t k = 0; k < others.size(); ++k) md << "---|---|---|";
+    md << "\n";
+    for (const auto& r : results) {
+        if (r.scene != name || r.run.curve() != recommended) continue;
+        md << "| " << r.run.label() << (r.belowNoise() ? " ‡" : "") << " | " << fmt(r.seconds) << " |";
+        if (r.belowNoise()) {  // the noise rule: no ratio
+            for (size_t k = 0; k < others.size(); ++k) md << " ‡ | ‡ | ‡ |";
+            md << "\n";
+            continue;
+        }
+        for (const auto& m : others) {
+            const auto rmseCurve = curveOf(results, name, m, false), smapeCurve = curveOf(results, name, m, true);
+            const auto e1 = errorAtTime(rmseCurve, r.seconds), e2 = errorAtTime(smapeCurve, r.seconds);
+            const auto t = timeToError(rmseCurve, r.metrics.rmse);
+            md << " " << (e1 ? fmt(*e1 / r.metrics.rmse) : "—") << " | " << (e2 ? fmt(*e2 / r.metrics.smape) : "—")
+               << " | " << (t ? fmt(*t / r.seconds) : "—") << " |";
+        }
+        md << "\n";
+    }
+    md << "\n";
+}
 
 void writeSummary(const fs::path& path, const Options& o, const std::vector<SceneReport>& scenes,
                   const std::vector<RunResult>& results, const std::vector<SpeedupResult>& speedups,
@@ -350,65 +460,33 @@ void writeSummary(const fs::path& path, const Options& o, const std::vector<Scen
           "**Noise rule.** A run whose RMSE is below " << fmt(kNoiseFactor) << "× the reference's own estimated RMSE "
           "cannot be told from the reference's noise: it is marked ‡ in the tables, written with below_noise = 1 in "
           "`results.csv`, and left out of every ratio (its curve then ends before it).\n\n";
-    md << "## Scenes\n\n| scene | description | resolution | reference (path tracer) | reference noise RMSE / rel. RMSE / SMAPE |\n|---|---|---|---|---|\n";
+    md << "## Scenes\n\n| scene | description | resolution | reference (whole image) | its noise RMSE / rel. RMSE / "
+          "SMAPE | part (d) reference | its noise RMSE / rel. RMSE / SMAPE |\n|---|---|---|---|---|---|---|\n";
     for (const auto& s : scenes) {
         if (!s.skipped.empty()) {
-            md << "| " << s.scene.name << " | " << s.scene.description << " | skipped: " << s.skipped << " | | |\n";
+            md << "| " << s.scene.name << " | " << s.scene.description << " | skipped: " << s.skipped << " | | | | |\n";
             continue;
         }
         md << "| " << s.scene.name << " | " << s.scene.description << (s.scene.medium.empty() ? "" : " (`--medium " + s.scene.medium + "`)")
            << " | " << s.scene.width << "x" << s.scene.height << " | " << s.reference.spp << " spp, "
            << fmt(s.reference.seconds, 4) << " s" << (s.reference.cached ? " (cached)" : "") << " | "
            << fmt(s.reference.noiseRmse) << " / " << fmt(s.reference.noiseRelativeRmse) << " / "
-           << fmt(s.reference.noiseSmape) << " |\n";
+           << fmt(s.reference.noiseSmape) << " | " << s.partReference.method << ", " << fmt(s.partReference.seconds, 4)
+           << " s" << (s.partReference.cached ? " (cached)" : "") << " | " << fmt(s.partReference.noiseRmse) << " / "
+           << fmt(s.partReference.noiseRelativeRmse) << " / " << fmt(s.partReference.noiseSmape) << " |\n";
     }
     md << "\n";
-    const std::vector<std::string> others = {"vrl", "vrl-stochastic K=8", "vrl-stochastic K=32", "vpl-lightcuts e=0.02",
-                                             "path"};
     for (const auto& s : scenes) {
         if (!s.skipped.empty()) continue;
         const std::string& name = s.scene.name;
-        md << "## " << name << "\n\n![error against time](error-time-" << safeName(name) << ".png)\n\n";
-        md << "| method | settings | time (s) | RMSE | RMSE / reference noise | rel. RMSE | SMAPE | mean ratio | #Eval | #Inter "
-              "|\n|---|---|---|---|---|---|---|---|---|---|\n";
-        for (const auto& r : results) {
-            if (r.scene != name) continue;
-            const bool cuts = usesLightTree(r.run.method);
-            md << "| " << methodTitle(r.run.method) << " | " << r.run.label() << " | " << fmt(r.seconds) << " | "
-               << fmt(r.metrics.rmse) << " | " << fmt(r.metrics.rmse / r.referenceNoiseRmse) << (r.belowNoise() ? " ‡" : "")
-               << " | " << fmt(r.metrics.relativeRmse) << " | " << fmt(r.metrics.smape) << " | "
-               << fmt(r.metrics.meanReference > 0 ? r.metrics.meanTest / r.metrics.meanReference : NAN) << " | "
-               << (cuts ? fmt(r.stats.meanEvaluated, 4) : "") << " | " << (cuts ? fmt(r.stats.meanIntersected, 4) : "")
-               << " |\n";
-        }
-        md << "\nEqual-time error ratios (the other method's error at VRL Lightcuts' time, divided by VRL Lightcuts' "
-              "error; > 1: VRL Lightcuts is better) and equal-error time ratios (the other method's time to reach VRL "
-              "Lightcuts' RMSE, divided by VRL Lightcuts' time; > 1: VRL Lightcuts is faster); '—' where the other "
-              "method's measured range (above the noise rule's floor) does not reach; ‡: below the noise rule's "
-              "floor, no ratio.\n\n";
-        md << "| VRL Lightcuts point | time (s) |";
-        for (const auto& m : others) md << " " << curveTitle(m) << ": RMSE × | SMAPE × | time × |";
-        md << "\n|---|---|";
-        for (size_t k = 0; k < others.size(); ++k) md << "---|---|---|";
-        md << "\n";
-        for (const auto& r : results) {
-            if (r.scene != name || r.run.curve() != "vrl-lightcuts e=0.02") continue;
-            md << "| " << r.run.label() << (r.belowNoise() ? " ‡" : "") << " | " << fmt(r.seconds) << " |";
-            if (r.belowNoise()) {  // the noise rule: no ratio
-                for (size_t k = 0; k < others.size(); ++k) md << " ‡ | ‡ | ‡ |";
-                md << "\n";
-                continue;
-            }
-            for (const auto& m : others) {
-                const auto rmseCurve = curveOf(results, name, m, false), smapeCurve = curveOf(results, name, m, true);
-                const auto e1 = errorAtTime(rmseCurve, r.seconds), e2 = errorAtTime(smapeCurve, r.seconds);
-                const auto t = timeToError(rmseCurve, r.metrics.rmse);
-                md << " " << (e1 ? fmt(*e1 / r.metrics.rmse) : "—") << " | " << (e2 ? fmt(*e2 / r.metrics.smape) : "—")
-                   << " | " << (t ? fmt(*t / r.seconds) : "—") << " |";
-            }
-            md << "\n";
-        }
-        md << "\n";
+        md << "## " << name << "\n\n### The whole image\n\n";
+        writeComparison(md, results, name, false);
+        md << "### Part (d) alone (multiple scattering: the paper's Figure 3 comparison)\n\n"
+           << "Against the part (d) reference; parts (a)-(c) are off, so only the virtual lights' own error counts. "
+              "Plain VRLs, VRL and VPL Lightcuts at 1 spp (rays through pixel centres: more samples only redraw the "
+              "estimators' numbers); stochastic VRL Lightcuts draw new cuts per sample. The path tracer cannot be "
+              "restricted to (d) here.\n\n";
+        writeComparison(md, results, name, true);
         for (const auto& line : s.images) md << line << "\n";
         md << "\n";
     }
@@ -468,7 +546,11 @@ int runReport(const Options& o) {
         const auto scene = loadScene(s);
         report.loadSeconds = secondsSince(loadStart);
         arena.execute([&] {
-            const Image reference = referenceImage(s, *scene, o.out / "cache", log, report.reference);
+            const fs::path referenceDir = o.quick ? o.out / "cache" : o.references;
+            const Image reference = referenceImage(s, *scene, ReferencePart::Image, referenceDir, log, report.reference);
+            const Image partReference =
+                referenceImage(s, *scene, ReferencePart::Multiple, referenceDir, log, report.partReference);
+            if (o.buildReferences) return;
             const float exposure = autoExposure(reference);
             writePreviewPng(reference, o.out / "images" / (safeName(s.name) + "-reference.png"), exposure);
             report.images.push_back("Reference and the largest setting of each method (same exposure):\n");
@@ -483,12 +565,17 @@ int runReport(const Options& o) {
                 RenderStatistics stats;
                 const auto runStart = Clock::now();
                 ImageSet images = render(*scene, settings, {}, &stats);
-                RunResult r{s.name, run, secondsSince(runStart), compareImages(reference, images.image), stats,
-                            report.reference.noiseRmse};
+                RunResult r{s.name, run, secondsSince(runStart),
+                            compareImages(run.multipleOnly ? partReference : reference, images.image), stats,
+                            run.multipleOnly ? report.partReference.noiseRmse : report.reference.noiseRmse};
                 log.line("%s (%zu/%zu): %-13s %-22s %8.2f s  RMSE %.4g  rel %.4g  SMAPE %.4g%s%s", s.name.c_str(), done,
                          totalRuns, std::string(methodName(run.method)).c_str(), run.label().c_str(), r.seconds, r.metrics.rmse,
                          r.metrics.relativeRmse, r.metrics.smape, r.belowNoise() ? "  (below the reference's noise)" : "",
                          r.metrics.nonFinitePixels ? "  (NON-FINITE PIXELS)" : "");
+                if (run.multipleOnly) {
+                    results.push_back(std::move(r));
+                    continue;
+                }
                 if ((run.method == RenderMethod::VrlLightcuts || run.method == RenderMethod::VplLightcuts) &&
                     run.lights == s.tableLights && run.errorThreshold == 0.02f) {
                     report.tableStats[run.method] = {stats.meanEvaluated, stats.meanIntersected};
@@ -548,7 +635,7 @@ int runReport(const Options& o) {
         // Write what we have after every scene: a long report interrupted keeps its data.
         std::ofstream csv(o.out / "results.csv");
         csv << "scene,method,setting,vrls,spp,error_threshold,seconds,rmse,rel_rmse,smape,mean_eval,mean_inter,mean_cut,"
-               "mean_ratio,cut_size,ref_noise_rmse,below_noise\n";
+               "mean_ratio,cut_size,ref_noise_rmse,below_noise,part\n";
         csv << std::setprecision(6);
         for (const auto& r : results)
             csv << r.scene << "," << methodName(r.run.method) << "," << r.run.label() << "," << r.run.lights << "," << r.run.spp << ","
@@ -556,7 +643,8 @@ int runReport(const Options& o) {
                 << r.metrics.smape << "," << r.stats.meanEvaluated << "," << r.stats.meanIntersected << ","
                 << r.stats.meanCutSize << ","
                 << (r.metrics.meanReference > 0 ? r.metrics.meanTest / r.metrics.meanReference : 0.0) << ","
-                << r.run.cutSize << "," << r.referenceNoiseRmse << "," << (r.belowNoise() ? 1 : 0) << "\n";
+                << r.run.cutSize << "," << r.referenceNoiseRmse << "," << (r.belowNoise() ? 1 : 0) << ","
+                << (r.run.multipleOnly ? "multiple" : "image") << "\n";
         std::ofstream sp(o.out / "speedup.csv");
         sp << "scene,kind,n,brute_seconds_per_pixel,lightcuts_seconds_per_pixel,speedup,mean_eval,mean_inter\n";
         sp << std::setprecision(6);
@@ -564,6 +652,11 @@ int runReport(const Options& o) {
             sp << r.scene << "," << r.kind << "," << r.lights << "," << r.bruteSecondsPerPixel << ","
                << r.lightcutsSecondsPerPixel << "," << r.bruteSecondsPerPixel / r.lightcutsSecondsPerPixel << ","
                << r.meanEval << "," << r.meanInter << "\n";
+    }
+    if (o.buildReferences) {
+        log.line("references done in %.1f min (in %s)", secondsSince(start) / 60.0,
+                 (o.quick ? o.out / "cache" : o.references).string().c_str());
+        return 0;
     }
     if (results.empty()) throw std::runtime_error("no benchmark scene could be rendered");
     if (o.plots) {
@@ -586,7 +679,14 @@ int main(int argc, char** argv) {
                  "on the benchmark scenes (CSV, plots, false-colour statistics, Markdown summary)"};
     Options o;
     app.add_option("-o,--out", o.out, "Output folder (created); references are cached in OUT/cache (default report)");
-    app.add_flag("--quick", o.quick, "A small version (our own scene at 32x24, short sweeps): under 3 minutes");
+    app.add_flag("--quick", o.quick, "A small version (our own scene at 32x24, short sweeps): under 3 minutes; its "
+                                     "references go to OUT/cache");
+    app.add_flag("--references", o.buildReferences,
+                 "Only build the references that are missing (the whole image by the path tracer, part (d) by "
+                 "stochastic VRL Lightcuts over independent VRL sets; hours), then stop");
+    app.add_option("--references-dir", o.references,
+                   "Where references are kept and looked up by a hash of scene, settings and method (default "
+                   "bench/references in the source tree)");
     app.add_option("--scenes", o.only, "Only these scenes (names as in the summary), comma-separated")->delimiter(',');
     app.add_option("--shared", o.shared, "The shared scene folder with staircase/, veach-lamp-mitsuba-bidir/, "
                                          "volumetric-caustic/ (default ../shared/scenes beside the repository)");

@@ -2,6 +2,7 @@
 
 #include "util/atomic_file.h"
 
+#include <Imath/half.h>
 #include <OpenEXR/ImfChannelList.h>
 #include <OpenEXR/ImfFrameBuffer.h>
 #include <OpenEXR/ImfHeader.h>
@@ -17,6 +18,9 @@
 
 #include <array>
 #include <cerrno>
+#include <cmath>
+#include <deque>
+#include <vector>
 #include <climits>
 #include <cstdint>
 #include <fstream>
@@ -147,24 +151,44 @@ ImageSet readExrFile(const std::filesystem::path& path) {
 
 }  // namespace
 
-void writeExr(const std::filesystem::path& path, const ImageSet& images) {
+void writeExr(const std::filesystem::path& path, const ImageSet& images, ExrPixels pixels) {
     checkWritable(path, images);
     const Image& image = images.image;
+    const Imf::PixelType type = pixels == ExrPixels::Half ? Imf::HALF : Imf::FLOAT;
+    if (pixels == ExrPixels::Half) {
+        constexpr float kHalfMax = 65504.0f;
+        const auto check = [&](const std::string& what, const Image& source) {
+            for (size_t i = 0; i < source.pixelCount(); ++i)
+                for (int c = 0; c < 3; ++c)
+                    if (std::isfinite(source[i][c]) && std::abs(source[i][c]) > kHalfMax)
+                        throw std::invalid_argument("cannot write " + quoted(path) + " in half precision: " + what +
+                                                    " has a value beyond 65504 (write it in float)");
+        };
+        check("the image", image);
+        for (const auto& [name, layer] : images.layers) check("layer " + name, layer);
+    }
     Imf::Header header(image.width(), image.height());  // data and display window at the origin
     header.compression() = Imf::ZIP_COMPRESSION;
     const Imath::Box2i dataWindow = header.dataWindow();
     Imf::FrameBuffer frameBuffer;
+    std::deque<std::vector<half>> halfPlanes;  // Half: the converted channels (OpenEXR does not convert on write)
+    const auto slice = [&](const Image& source, int c) {
+        if (pixels == ExrPixels::Float) return componentSlice(source, c, dataWindow);
+        auto& plane = halfPlanes.emplace_back(source.pixelCount());
+        for (size_t i = 0; i < plane.size(); ++i) plane[i] = half(source[i][c]);
+        return Imf::Slice::Make(Imf::HALF, plane.data(), dataWindow);
+    };
     auto addRgb = [&](const std::string& prefix, const Image& source) {
         for (int c = 0; c < 3; ++c) {
-            header.channels().insert(prefix + kComponents[c], Imf::Channel(Imf::FLOAT));
-            frameBuffer.insert(prefix + kComponents[c], componentSlice(source, c, dataWindow));
+            header.channels().insert(prefix + kComponents[c], Imf::Channel(type));
+            frameBuffer.insert(prefix + kComponents[c], slice(source, c));
         }
     };
     addRgb("", image);
     for (const auto& [name, layer] : images.layers) {
         if (images.singleChannelLayers.count(name)) {
-            header.channels().insert(name + ".Y", Imf::Channel(Imf::FLOAT));
-            frameBuffer.insert(name + ".Y", componentSlice(layer, 0, dataWindow));
+            header.channels().insert(name + ".Y", Imf::Channel(type));
+            frameBuffer.insert(name + ".Y", slice(layer, 0));
         } else {
             addRgb(name + ".", layer);
         }

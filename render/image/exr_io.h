@@ -22,7 +22,11 @@ namespace vrl {
 // or key longer than OpenEXR's 255 characters, or the key "type" (OpenEXR's
 // part type); std::runtime_error naming the path for any I/O or OpenEXR
 // failure (e.g. a missing directory, a key naming a standard attribute).
-void writeExr(const std::filesystem::path& path, const ImageSet& images);
+// `pixels`: the channels' type; Half (16-bit, relative precision 2^-11, largest
+// 65504) halves the file for images that need no more, e.g. cached references;
+// it throws std::invalid_argument for a value beyond half's range.
+enum class ExrPixels { Float, Half };
+void writeExr(const std::filesystem::path& path, const ImageSet& images, ExrPixels pixels = ExrPixels::Float);
 
 // Reads the first part of an EXR file, whichever tool wrote it: channels
 // R, G, B (or, if none of them is present, a single Y channel as grey) into

@@ -12,7 +12,7 @@ elapsed=$(( $(date +%s) - start ))
 echo "quick report: ${elapsed} s"
 fail() { echo "FAIL: $*" >&2; exit 1; }
 [ "$elapsed" -lt 180 ] || fail "--quick took ${elapsed} s (must stay under 3 minutes)"
-for f in results.csv speedup.csv summary.md error-time-bathroom.png speedup.png \
+for f in results.csv speedup.csv summary.md error-time-bathroom.png error-time-bathroom-d.png speedup.png \
          images/bathroom-reference.png images/bathroom-vrl-lightcuts-eval.png images/bathroom-vpl-lightcuts-inter.png; do
     [ -s "$out/$f" ] || fail "missing or empty $out/$f"
 done
@@ -21,14 +21,24 @@ head -1 "$out/results.csv" | grep -q '^scene,method,setting,vrls,spp,error_thres
 for m in path vrl vrl-lightcuts vrl-stochastic vpl-lightcuts; do
     grep -q "^bathroom,$m," "$out/results.csv" || fail "no $m row in results.csv"
 done
-# Every row has 17 fields and finite, non-negative errors.
-awk -F, 'NR > 1 { if (NF != 17) { print "bad field count: " $0; exit 1 }
+# Every row has 18 fields and finite, non-negative errors.
+awk -F, 'NR > 1 { if (NF != 18) { print "bad field count: " $0; exit 1 }
                   for (i = 7; i <= 10; ++i) if ($i !~ /^[0-9.e+-]+$/ || $i < 0) { print "bad number: " $0; exit 1 } }' \
     "$out/results.csv" || fail "results.csv rows"
-head -1 "$out/results.csv" | grep -q ',cut_size,ref_noise_rmse,below_noise$' || fail "results.csv noise columns"
+head -1 "$out/results.csv" | grep -q ',cut_size,ref_noise_rmse,below_noise,part$' || fail "results.csv noise columns"
 # Stochastic runs at two cut sizes.
 [ "$(awk -F, '$2 == "vrl-stochastic" { print $15 }' "$out/results.csv" | sort -u | wc -l)" -eq 2 ] \
     || fail "vrl-stochastic should run at two cut sizes"
+# Part (d) alone: every virtual-light method, against its own reference (whose noise differs).
+for m in vrl vrl-lightcuts vrl-stochastic vpl-lightcuts; do
+    grep -q "^bathroom,$m,.*,multiple$" "$out/results.csv" || fail "no part (d) $m row in results.csv"
+done
+grep -q "^bathroom,path,.*,multiple$" "$out/results.csv" && fail "the path tracer has no part (d) row"
+[ "$(awk -F, 'NR > 1 { print $18 ":" $16 }' "$out/results.csv" | sort -u | wc -l)" -eq 2 ] \
+    || fail "the two parts should each have one reference noise"
+grep -q "Part (d) alone" "$out/summary.md" || fail "summary.md lacks the part (d) comparison"
+ls "$out"/cache/bathroom-reference-d-*.exr >/dev/null 2>&1 || fail "no cached part (d) reference"
+ls "$out"/cache/bathroom-reference-d-*.txt >/dev/null 2>&1 || fail "no note beside the part (d) reference"
 # The noise rule: below_noise is 1 exactly where RMSE < 3 x the reference's noise RMSE,
 # and the reference's noise is measured (positive).
 awk -F, 'NR > 1 { if (!($16 > 0)) { print "no reference noise: " $0; exit 1 }
@@ -50,4 +60,5 @@ grep -E '^\| bathroom \| 10000 \| [0-9]' "$out/summary.md" >/dev/null || fail "T
 # A second run takes the reference from the cache.
 second=$("$report" --quick --no-plots -o "$out" 2>&1) || fail "the second run failed: $second"
 grep -q "reference from the cache" <<<"$second" || fail "the reference was not cached"
+grep -q "part (d) reference from the cache" <<<"$second" || fail "the part (d) reference was not cached"
 echo "PASS"

@@ -118,6 +118,44 @@ TEST_F(ExrIoTest, RoundTripIsBitExact) {
     EXPECT_EQ(read.metadata, written.metadata);
 }
 
+// Half precision (cached references): values come back to half's precision
+// (relative 2^-11 for normal numbers; the random values here are in [0, 8)), the
+// file is smaller than the float one, and a value beyond 65504 is refused.
+TEST_F(ExrIoTest, HalfPrecisionRoundTripsToHalfAccuracy) {
+    const auto moderate = [](uint32_t seed) {
+        std::mt19937 rng(seed);
+        std::uniform_real_distribution<float> value(0.0f, 8.0f);
+        Image image(17, 9);
+        for (size_t i = 0; i < image.pixelCount(); ++i) image[i] = Rgb(value(rng), value(rng), value(rng));
+        return image;
+    };
+    ImageSet written;
+    written.image = moderate(4);
+    written.layers = {{"half1", moderate(5)}};
+    const fs::path halfPath = dir_ / "half.exr", floatPath = dir_ / "float.exr";
+    writeExr(halfPath, written, ExrPixels::Half);
+    writeExr(floatPath, written);
+    const ImageSet read = readExr(halfPath);
+    ASSERT_EQ(read.layers.size(), 1u);
+    for (size_t i = 0; i < written.image.pixelCount(); ++i)
+        for (int c = 0; c < 3; ++c) {
+            const float a = written.image[i][c], b = read.image[i][c];
+            EXPECT_NEAR(b, a, std::abs(a) * 0x1p-11f + 6e-8f) << i;
+            EXPECT_NEAR(read.layers[0].second[i][c], written.layers[0].second[i][c],
+                        std::abs(written.layers[0].second[i][c]) * 0x1p-11f + 6e-8f);
+        }
+    EXPECT_LT(fs::file_size(halfPath), fs::file_size(floatPath));
+    ImageSet bright = written;
+    bright.layers[0].second[3] = Rgb(70000.0f, 1.0f, 1.0f);
+    try {
+        writeExr(dir_ / "bright.exr", bright, ExrPixels::Half);
+        FAIL() << "no exception for a value beyond half's range";
+    } catch (const std::invalid_argument& e) {
+        EXPECT_NE(std::string(e.what()).find("half1"), std::string::npos) << e.what();
+    }
+    EXPECT_FALSE(fs::exists(dir_ / "bright.exr"));
+}
+
 // Counter layers are one channel ("eval.Y"), read back grey and still marked single-channel.
 TEST_F(ExrIoTest, SingleChannelLayersRoundTripAsOneChannel) {
     ImageSet written;
