@@ -37,6 +37,7 @@ grep -q "^bathroom,path,.*,multiple$" "$out/results.csv" && fail "the path trace
 [ "$(awk -F, 'NR > 1 { print $18 ":" $16 }' "$out/results.csv" | sort -u | wc -l)" -eq 2 ] \
     || fail "the two parts should each have one reference noise"
 grep -q "Part (d) alone" "$out/summary.md" || fail "summary.md lacks the part (d) comparison"
+[ "$(grep -c '^\*\*Verdict for' "$out/summary.md")" -eq 2 ] || fail "summary.md should give a verdict per part"
 ls "$out"/cache/bathroom-reference-d-*.exr >/dev/null 2>&1 || fail "no cached part (d) reference"
 ls "$out"/cache/bathroom-reference-d-*.txt >/dev/null 2>&1 || fail "no note beside the part (d) reference"
 # The noise rule: below_noise is 1 exactly where RMSE < 3 x the reference's noise RMSE,
