@@ -267,6 +267,52 @@ Image referenceImage(const BenchmarkScene& s, const Scene& scene, ReferencePart 
     return set.image;
 }
 
+// The part (d) reference against an independent estimate of the same quantity:
+// plain VRLs averaged over `sets` independent VRL sets of `vrls` VRLs (also
+// unbiased for the true transport). Their difference's RMSE (on luminance) is
+// compared with what their two noises predict, sqrt(noise_ref^2 + noise_plain^2),
+// the plain mean's noise from the spread of its sets.
+struct ReferenceCheck {
+    int sets = 0;
+    uint64_t vrls = 0;
+    double differenceRmse = 0.0, expectedRmse = 0.0, seconds = 0.0;
+    double plainNoiseRmse = 0.0;  // of the plain mean
+    bool done() const { return sets > 0; }
+};
+
+ReferenceCheck checkPartReference(const BenchmarkScene& s, const Scene& scene, const Image& reference,
+                                  const ReferenceInfo& info, int sets, uint64_t vrls, const Log& log) {
+    ReferenceCheck c;
+    c.sets = sets, c.vrls = vrls;
+    const auto start = Clock::now();
+    const size_t n = size_t(s.width) * size_t(s.height);
+    std::vector<double> sum(n, 0.0), sum2(n, 0.0);
+    for (int k = 0; k < sets; ++k) {
+        RenderSettings settings = settingsFor(s, MethodRun{RenderMethod::Vrl, vrls, 1}, 3000017 + uint64_t(k));
+        settings.transports = TransportSelection::parse("multiple");
+        const Image image = render(scene, settings).image;
+        for (size_t i = 0; i < n; ++i) {
+            const double y = luminance(image[i]);
+            sum[i] += y, sum2[i] += y * y;
+        }
+    }
+    double difference2 = 0.0, variance = 0.0;
+    for (size_t i = 0; i < n; ++i) {
+        const double mean = sum[i] / sets;
+        variance += std::max(0.0, sum2[i] / sets - mean * mean) / (sets - 1);  // of the mean
+        const double d = mean - double(luminance(reference[i]));
+        difference2 += d * d;
+    }
+    c.differenceRmse = std::sqrt(difference2 / double(n));
+    c.plainNoiseRmse = std::sqrt(variance / double(n));
+    c.expectedRmse = std::sqrt(info.noiseRmse * info.noiseRmse + variance / double(n));
+    c.seconds = secondsSince(start);
+    log.line("%s: part (d) reference check: plain VRLs over %d sets of %llu: RMSE of the difference %.4g, expected "
+             "from the noises %.4g (ratio %.2f)", s.name.c_str(), sets, (unsigned long long)vrls, c.differenceRmse,
+             c.expectedRmse, c.differenceRmse / c.expectedRmse);
+    return c;
+}
+
 // Figure 4: seconds per pixel of brute force (plain VRLs / VPLs) and of
 // Lightcuts, multiple scattering (d) only, on a fixed spread of pixels.
 std::vector<SpeedupResult> measureSpeedup(const BenchmarkScene& s, const Scene& scene, const Log& log) {
@@ -377,6 +423,7 @@ std::string curveTitle(std::string curve) {
 struct SceneReport {
     BenchmarkScene scene;
     ReferenceInfo reference, partReference;
+    ReferenceCheck partCheck;  // the first scene's only
     double loadSeconds = 0.0;
     std::string skipped;  // reason, if skipped
     std::map<RenderMethod, std::pair<double, double>> tableStats;  // method -> (#Eval, #Inter)
@@ -533,6 +580,22 @@ void writeSummary(const fs::path& path, const Options& o, const std::vector<Scen
     }
     md << "\n";
     for (const auto& s : scenes) {
+        if (!s.partCheck.done()) continue;
+        const ReferenceCheck& c = s.partCheck;
+        const double ratio = c.differenceRmse / c.expectedRmse;
+        md << "**Part (d) reference check** (" << s.scene.name << "): the part (d) reference against plain VRLs "
+           << "averaged over " << c.sets << " independent VRL sets of " << c.vrls << " VRLs (both estimate the true "
+           << "transport without bias): RMSE of their difference " << fmt(c.differenceRmse) << ", expected from "
+           << "their two noises " << fmt(c.expectedRmse) << " (ratio " << fmt(ratio) << "; "
+           << (ratio < 1.5 ? "they agree within their noise" : "**they do not agree within their noise**")
+           << "). Cost of a noise (time × noise², lower is better): the stochastic reference "
+           << fmt(s.partReference.seconds * s.partReference.noiseRmse * s.partReference.noiseRmse) << " ("
+           << fmt(s.partReference.seconds) << " s, noise " << fmt(s.partReference.noiseRmse)
+           << (s.partReference.cached ? ", time as recorded in the cache" : "") << "), plain VRLs over sets "
+           << fmt(c.seconds * c.plainNoiseRmse * c.plainNoiseRmse) << " (" << fmt(c.seconds) << " s, noise "
+           << fmt(c.plainNoiseRmse) << ").\n\n";
+    }
+    for (const auto& s : scenes) {
         if (!s.skipped.empty()) continue;
         const std::string& name = s.scene.name;
         md << "## " << name << "\n\n### The whole image\n\n";
@@ -607,6 +670,9 @@ int runReport(const Options& o) {
             const Image partReference =
                 referenceImage(s, *scene, ReferencePart::Multiple, referenceDir, log, report.partReference);
             if (o.buildReferences) return;
+            if (scenes.empty())  // the first scene: the part (d) reference against plain VRLs over independent sets
+                report.partCheck = checkPartReference(s, *scene, partReference, report.partReference, 16,
+                                                      o.quick ? 3000 : 2000, log);
             const float exposure = autoExposure(reference);
             writePreviewPng(reference, o.out / "images" / (safeName(s.name) + "-reference.png"), exposure);
             report.images.push_back("Reference and the largest setting of each method (same exposure):\n");
