@@ -32,7 +32,9 @@ struct CutSettings {
 
 // Per-pixel counters (the paper's Table 1).
 struct CutStatistics {
-    uint32_t evaluated = 0;    // #Eval: estimator evaluations (nodes and leaves)
+    uint32_t evaluated = 0;    // #Eval: nodes and leaves estimated in the cut (as in the paper; a child that
+                               // shares its refined parent's representative inherits its estimate and costs
+                               // no estimator call, cut_walk.h)
     uint32_t intersected = 0;  // #Inter: nodes whose box the camera line crossed
     uint32_t cutSize = 0;      // nodes in the final cut
     uint32_t boundExceeded = 0;  // inner-node estimates above their bound (HG media; 0 if isotropic)

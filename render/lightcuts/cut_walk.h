@@ -22,10 +22,18 @@
 // Batched refinement: the node with the largest bound is refined, and with it
 // the next ones of the heap whose bounds also exceed the threshold of the total
 // before this step (kRefineBatch at most), so that one kernel call estimates
-// several new representatives in its lanes. The sequential walk would refine
-// those nodes too unless the total grew past their bounds' threshold in the
-// meantime; the batch can therefore only end with a few more refined nodes (a
-// finer cut, never a coarser one).
+// several new representatives in its lanes. The sequential walk would mostly
+// refine those nodes too, so the cut usually ends the same or a few nodes finer;
+// it is not guaranteed to be finer (estimates do not add up exactly, so the
+// total after a batch may differ from the sequential walk's and a later step
+// may stop earlier), and at maxCutSize a batch may take the heap's next nodes
+// where the sequential walk would take a just-created child. Both walks keep
+// the error test; the cut never exceeds maxCutSize by more than the crossed
+// nodes' children (as before, but found after a whole batch).
+//
+// A crossed node (refined without an estimate) that shares its parent's
+// representative passes the inherited estimate on to its children, so a walk to
+// the leaves evaluates every VRL exactly once.
 #pragma once
 
 #include "render/core/rgb.h"
@@ -50,7 +58,8 @@ struct CutScratch {
     std::vector<CutNode> heap;      // a max-heap (std::push_heap) on bound
     struct Pending {
         int32_t node;
-        int32_t parent;  // the refined parent whose estimate it may inherit; -1: none (root, crossed parent)
+        int32_t parent;  // the parent whose estimate it may inherit; -1: none (the root, the children
+                         // of a crossed node that did not share its own parent's representative)
         Rgb parentEstimate;
     };
     std::vector<Pending> pending;   // nodes to add to the cut (children of refined nodes)
@@ -126,13 +135,17 @@ Rgb walkCut(const LightTree& tree, const CutSettings& settings, CutStatistics& s
             const int32_t i = p.node;
             const LightTreeNode& node = nodes[i];
             Rgb b(0.0f);
+            const bool shares = p.parent >= 0 && node.representative == nodes[p.parent].representative;
             if (!node.isLeaf() && !visitor.bound(i, b)) {  // infinite bound: refine without estimating
                 ++statistics.intersected;
-                pending.push_back({node.left, -1, Rgb(0.0f)});
-                pending.push_back({node.right, -1, Rgb(0.0f)});
+                // Its estimate, had it been made, is known when it shares the parent's
+                // representative: its children may inherit from it.
+                const Rgb e = shares ? inherit(p.parentEstimate, p.parent, i) : Rgb(0.0f);
+                pending.push_back({node.left, shares ? i : -1, e});
+                pending.push_back({node.right, shares ? i : -1, e});
                 continue;
             }
-            if (p.parent >= 0 && node.representative == nodes[p.parent].representative) {
+            if (shares) {
                 added.push_back({0.0f, i, inherit(p.parentEstimate, p.parent, i)});
                 scratch.addedBounds.push_back(b);
                 continue;

@@ -478,6 +478,13 @@ LightTree LightTree::fromParts(std::vector<Vrl> vrls, std::vector<LightTreeNode>
             if (c < 0 || size_t(c) >= nodes.size()) throw std::invalid_argument("light tree: child index out of range");
             stack.push_back(c);
         }
+        // Cuts scale a parent's estimate by flux ratios (cut_walk.h): an inner node's
+        // fluxes must be finite and non-negative.
+        for (int c = 0; c < 3; ++c)
+            if (!(n.clusterFlux[c] >= 0.0f && n.clusterFlux[c] < kInfinity && n.fluxLength[c] >= 0.0f &&
+                  n.fluxLength[c] < kInfinity))
+                throw std::invalid_argument("light tree: node " + std::to_string(i) +
+                                            " has a negative or non-finite flux");
         const LightTreeNode& l = nodes[n.left];
         const LightTreeNode& r = nodes[n.right];
         if (n.vrlCount != l.vrlCount + r.vrlCount ||

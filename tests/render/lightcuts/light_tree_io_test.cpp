@@ -10,6 +10,7 @@
 #include <bit>
 #include <cstdint>
 #include <functional>
+#include <limits>
 #include <stdexcept>
 #include <string>
 #include <utility>
@@ -166,6 +167,26 @@ TEST(LightTreeIo, RandomTreeOfHundredsOfVrlsRoundTrips) {
     const LightTree tree = makeTree(std::move(vrls), merges);
     ASSERT_EQ(tree.nodes()[size_t(tree.root())].vrlCount, 317u);
     expectRoundTrip(tree);
+}
+
+// An inner node's fluxes scale inherited cut estimates: NaN, infinite or negative
+// ones are refused by name.
+TEST(LightTreeIo, InnerNodesWithBadFluxAreRefused) {
+    const LightTree good = smallTree();
+    for (const float bad : {std::numeric_limits<float>::quiet_NaN(), std::numeric_limits<float>::infinity(), -1.0f}) {
+        for (const bool cluster : {true, false}) {
+            std::vector<LightTreeNode> nodes = good.nodes();
+            Rgb& flux = cluster ? nodes[3].clusterFlux : nodes[3].fluxLength;
+            flux.y = bad;
+            try {
+                LightTree::fromParts(good.vrls(), nodes, good.root());
+                ADD_FAILURE() << "accepted flux " << bad;
+            } catch (const std::invalid_argument& e) {
+                EXPECT_NE(std::string(e.what()).find("node 3 has a negative or non-finite flux"), std::string::npos)
+                    << e.what();
+            }
+        }
+    }
 }
 
 TEST(LightTreeIo, EmptyTreeRoundTrips) {
