@@ -38,6 +38,9 @@ echo "workers_interrupt_test: ok: SIGINT: exit 130, $(grep -o 'partial image wit
 "$vrl" render "$scene" -o "$work/killed.exr" "${flags[@]}" > /dev/null 2> "$work/killed.err" &
 render=$!; pids+=("$render")
 sleep 2
+# As in 1: on a loaded machine the job may still be starting at 2 s (its folder not
+# made yet; this test failed so once under a parallel ctest): wait for rendering.
+for _ in $(seq 300); do grep -q "^rendering" "$work/killed.err" && break; sleep 0.2; done
 left || fail "no vrl-local-* folder while rendering"
 kill -9 "$render"; wait "$render" 2>/dev/null
 deadline=$((SECONDS + 15))
