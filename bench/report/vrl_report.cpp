@@ -50,6 +50,7 @@ using Clock = std::chrono::steady_clock;
 struct Options {
     fs::path out = "report";
     bool buildReferences = false;  // --references: build the missing references, then stop
+    double referenceMinutes = 0.0;  // --references: stop after this long (0: no limit); a later run resumes
     fs::path references = fs::path(VRL_SOURCE_DIR) / "bench" / "references";  // --quick: OUT/cache
     fs::path shared = fs::path(VRL_SOURCE_DIR).parent_path() / "shared" / "scenes";
     bool quick = false;
@@ -91,6 +92,7 @@ struct ReferenceInfo {
     int spp = 0;
     double seconds = 0.0;  // when rendered in this run or recorded in the cache
     bool cached = false;
+    bool incomplete = false;  // stopped at the time limit; its chunks so far are kept in a .partial.exr
     double noiseRmse = 0.0, noiseRelativeRmse = 0.0, noiseSmape = 0.0;
     fs::path file;
 };
@@ -151,13 +153,21 @@ RenderSettings settingsFor(const BenchmarkScene& s, const MethodRun& run, uint64
     return settings;
 }
 
-// The settings of one half of a reference.
-RenderSettings referenceSettings(const BenchmarkScene& s, ReferencePart part, uint64_t half) {
+// A reference half is rendered in kReferenceChunks chunks of equal spp, each with
+// its own seed (so its own random streams and, for part (d), its own VRL sets),
+// saved after each chunk: a long reference can be built over several runs.
+constexpr int kReferenceChunks = 8;
+
+// The settings of chunk `chunk` of one half of a reference.
+RenderSettings referenceSettings(const BenchmarkScene& s, ReferencePart part, uint64_t half, int chunk) {
+    const uint64_t seed = 2 * uint64_t(chunk) + half;  // the halves and chunks: disjoint streams
     if (part == ReferencePart::Image)
-        return settingsFor(s, MethodRun{RenderMethod::Path, 0, std::max(1, s.referenceSpp / 2)}, 1000003 + half);
-    RenderSettings settings =
-        settingsFor(s, MethodRun{RenderMethod::VrlStochastic, s.partReferenceVrls, s.partReferenceSpp, 0.02f, 32},
-                    2000003 + half);  // the seed also keys the halves' VRL sets: independent
+        return settingsFor(s, MethodRun{RenderMethod::Path, 0, std::max(1, s.referenceSpp / 2 / kReferenceChunks)},
+                           1000003 + seed);
+    RenderSettings settings = settingsFor(
+        s, MethodRun{RenderMethod::VrlStochastic, s.partReferenceVrls,
+                     std::max(1, s.partReferenceSpp / kReferenceChunks), 0.02f, 32},
+        2000003 + seed);  // the seed also keys the chunk's VRL sets: independent
     settings.transports = TransportSelection::parse("multiple");
     settings.vrlSets = s.partReferenceSets;
     return settings;
@@ -180,23 +190,26 @@ std::string gitCommit() {
 // halves, keyed by a hash of the scene's files, the settings and the method, and
 // a text file beside it with the settings, the code version and the estimated noise.
 Image referenceImage(const BenchmarkScene& s, const Scene& scene, ReferencePart part, const fs::path& dir,
-                     const Log& log, ReferenceInfo& info) {
-    const RenderSettings first = referenceSettings(s, part, 0);
+                     const Log& log, ReferenceInfo& info, double minutes = 0.0) {
+    const RenderSettings first = referenceSettings(s, part, 0, 0);
     const bool image = part == ReferencePart::Image;
     const std::string what = image ? "reference" : "part (d) reference";
-    std::string key = image ? "path spp=" + std::to_string(first.samplesPerPixel) + "x2"
+    const int chunks = kReferenceChunks;
+    const int perHalf = chunks * first.samplesPerPixel;
+    std::string key = image ? "path spp=" + std::to_string(first.samplesPerPixel) + "x" + std::to_string(chunks) + "x2"
                             : "vrl-stochastic transports=multiple K=32 vrls=" + std::to_string(first.vrlCount) +
                                   " sets=" + std::to_string(first.vrlSets) + " spp=" +
-                                  std::to_string(first.samplesPerPixel) + "x2";
+                                  std::to_string(first.samplesPerPixel) + "x" + std::to_string(chunks) + "x2";
     key += " maxDepth=" + std::to_string(s.maxDepth) + " size=" + std::to_string(s.width) + "x" +
            std::to_string(s.height) + " medium=" + s.medium + " version=" + VRL_VERSION;
     const fs::path file =
         dir / (s.name + (image ? "-reference-" : "-reference-d-") + hashSceneAndSettings(s, key) + ".exr");
     info.part = part;
-    info.method = image ? "path tracer, " + std::to_string(2 * first.samplesPerPixel) + " spp"
-                        : "stochastic VRL Lightcuts (K = 32), " + std::to_string(2 * first.vrlSets) + " VRL sets of " +
-                              std::to_string(first.vrlCount) + ", " + std::to_string(2 * first.samplesPerPixel) + " spp";
-    info.spp = 2 * first.samplesPerPixel;
+    info.method = image ? "path tracer, " + std::to_string(2 * perHalf) + " spp"
+                        : "stochastic VRL Lightcuts (K = 32), " + std::to_string(2 * chunks * first.vrlSets) +
+                              " VRL sets of " + std::to_string(first.vrlCount) + ", " + std::to_string(2 * perHalf) +
+                              " spp";
+    info.spp = 2 * perHalf;
     info.file = file;
     ImageSet set;
     if (fs::exists(file)) {
@@ -205,21 +218,51 @@ Image referenceImage(const BenchmarkScene& s, const Scene& scene, ReferencePart 
         info.seconds = metadataNumber(set.metadata["vrl.report.seconds"]);
         log.line("%s: %s from the cache (%s)", s.name.c_str(), what.c_str(), file.filename().c_str());
     } else {
-        log.line("%s: rendering the %s, %s in two halves (%dx%d)...", s.name.c_str(), what.c_str(), info.method.c_str(),
-                 s.width, s.height);
-        const auto start = Clock::now();
-        std::vector<Image> halves;
-        for (uint64_t h = 0; h < 2; ++h) {
-            int lastDecile = -1;
-            halves.push_back(render(scene, referenceSettings(s, part, h), [&](const char*, double f) {
-                const int decile = int(f * 10.0);
-                if (decile > lastDecile && decile % 2 == 0) {
-                    lastDecile = decile;
-                    log.line("%s: %s half %d: %d%%", s.name.c_str(), what.c_str(), int(h) + 1, decile * 10);
-                }
-            }).image);
+        // Resume from the chunks a stopped run saved.
+        const fs::path partial = fs::path(file).replace_extension(".partial.exr");
+        std::vector<Image> halves(2, Image(s.width, s.height));
+        int done = 0;
+        double seconds = 0.0;
+        if (fs::exists(partial)) {
+            ImageSet saved = readExr(partial);
+            if (std::get<std::string>(saved.metadata["vrl.report.key"]) != key || saved.layers.size() != 2)
+                throw std::runtime_error(partial.string() + " belongs to other settings; delete it");
+            halves = {saved.layers[0].second, saved.layers[1].second};  // half1, half2 (sorted by name)
+            done = std::get<int32_t>(saved.metadata["vrl.report.chunks"]);
+            seconds = metadataNumber(saved.metadata["vrl.report.seconds"]);
+            log.line("%s: %s: resuming after %d of %d chunks", s.name.c_str(), what.c_str(), done, chunks);
+        } else {
+            log.line("%s: rendering the %s, %s in two halves of %d chunks (%dx%d)...", s.name.c_str(), what.c_str(),
+                     info.method.c_str(), chunks, s.width, s.height);
         }
-        info.seconds = secondsSince(start);
+        const auto start = Clock::now();
+        while (done < chunks) {
+            for (uint64_t h = 0; h < 2; ++h) {
+                const Image chunk = render(scene, referenceSettings(s, part, h, done)).image;
+                for (size_t i = 0; i < chunk.pixelCount(); ++i)  // the running mean of the chunks
+                    halves[h][i] = halves[h][i] + (chunk[i] - halves[h][i]) * (1.0f / float(done + 1));
+            }
+            ++done;
+            log.line("%s: %s: chunk %d of %d", s.name.c_str(), what.c_str(), done, chunks);
+            // At the time limit (after at least one chunk, so that every run makes progress):
+            // keep the chunks for the next run.
+            if (done < chunks && minutes > 0.0 && secondsSince(start) > 60.0 * minutes) {
+                ImageSet save;
+                save.image = halves[0];
+                save.layers = {{"half1", halves[0]}, {"half2", halves[1]}};
+                save.metadata["vrl.report.key"] = key;
+                save.metadata["vrl.report.chunks"] = int32_t(done);
+                save.metadata["vrl.report.seconds"] = seconds + secondsSince(start);
+                fs::create_directories(dir);
+                writeExr(partial, save);
+                log.line("%s: %s stopped at the time limit after %d of %d chunks (kept in %s; run again to go on)",
+                         s.name.c_str(), what.c_str(), done, chunks, partial.filename().c_str());
+                info.incomplete = true;
+                return Image();
+            }
+        }
+        info.seconds = seconds + secondsSince(start);
+        fs::remove(partial);
         Image mean(s.width, s.height);
         for (size_t i = 0; i < mean.pixelCount(); ++i) mean[i] = (halves[0][i] + halves[1][i]) * 0.5f;
         set.image = mean;
@@ -229,9 +272,9 @@ Image referenceImage(const BenchmarkScene& s, const Scene& scene, ReferencePart 
         record.defines = s.defines;
         record.medium = s.medium;
         record.settings = first;
-        record.settings.samplesPerPixel = 2 * first.samplesPerPixel;  // the two halves together
+        record.settings.samplesPerPixel = 2 * perHalf;  // the chunks of the two halves together
         record.statistics.seconds = info.seconds;
-        record.run = {{"halves", int32_t(2)}};
+        record.run = {{"halves", int32_t(2)}, {"chunks", int32_t(chunks)}};
         writeRenderMetadata(record, scene.camera(), set.metadata);
         set.metadata["vrl.report.key"] = key;
         set.metadata["vrl.report.seconds"] = info.seconds;
@@ -666,9 +709,13 @@ int runReport(const Options& o) {
         report.loadSeconds = secondsSince(loadStart);
         arena.execute([&] {
             const fs::path referenceDir = o.quick ? o.out / "cache" : o.references;
-            const Image reference = referenceImage(s, *scene, ReferencePart::Image, referenceDir, log, report.reference);
+            const double minutes = o.buildReferences ? o.referenceMinutes : 0.0;
+            const auto referenceStart = Clock::now();
+            const Image reference =
+                referenceImage(s, *scene, ReferencePart::Image, referenceDir, log, report.reference, minutes);
+            const double left = minutes > 0.0 ? std::max(1e-9, minutes - secondsSince(referenceStart) / 60.0) : 0.0;
             const Image partReference =
-                referenceImage(s, *scene, ReferencePart::Multiple, referenceDir, log, report.partReference);
+                referenceImage(s, *scene, ReferencePart::Multiple, referenceDir, log, report.partReference, left);
             if (o.buildReferences) return;
             if (scenes.empty())  // the first scene: the part (d) reference against plain VRLs over independent sets
                 report.partCheck = checkPartReference(s, *scene, partReference, report.partReference, 16,
@@ -806,6 +853,10 @@ int main(int argc, char** argv) {
     app.add_flag("--references", o.buildReferences,
                  "Only build the references that are missing (the whole image by the path tracer, part (d) by "
                  "stochastic VRL Lightcuts over independent VRL sets; hours), then stop");
+    app.add_option("--reference-minutes", o.referenceMinutes,
+                   "--references: stop each scene's references after about this many minutes, at least one chunk "
+                   "each (0, the default: no limit); the chunks done are kept and a later run resumes them")
+        ->check(CLI::NonNegativeNumber);
     app.add_option("--references-dir", o.references,
                    "Where references are kept and looked up by a hash of scene, settings and method (default "
                    "bench/references in the source tree)");

@@ -7,7 +7,15 @@ report=$1
 out=$2
 rm -rf "$out"
 start=$(date +%s)
-"$report" --quick -o "$out"
+# References are built in chunks and resumable: a run stopped at its time limit keeps
+# its chunks (.partial.exr), and the next one goes on from there.
+stopped=$("$report" --quick --references --reference-minutes 0.001 -o "$out" 2>&1) || { echo "$stopped"; exit 1; }
+grep -q "stopped at the time limit after 1 of 8 chunks" <<<"$stopped" || { echo "$stopped"; echo "FAIL: no stop" >&2; exit 1; }
+ls "$out"/cache/bathroom-reference-*.partial.exr >/dev/null 2>&1 || { echo "FAIL: no partial reference" >&2; exit 1; }
+log=$("$report" --quick -o "$out" 2>&1) || { echo "$log"; exit 1; }
+echo "$log"
+grep -q "reference: resuming after 1 of 8 chunks" <<<"$log" || { echo "FAIL: the reference did not resume" >&2; exit 1; }
+! ls "$out"/cache/*.partial.exr >/dev/null 2>&1 || { echo "FAIL: a partial reference was left" >&2; exit 1; }
 elapsed=$(( $(date +%s) - start ))
 echo "quick report: ${elapsed} s"
 fail() { echo "FAIL: $*" >&2; exit 1; }
