@@ -34,6 +34,7 @@ RESULTS_COLUMNS = [
 SPEEDUP_COLUMNS = [
     "scene", "kind", "n", "brute_seconds_per_pixel",
     "lightcuts_seconds_per_pixel", "speedup", "mean_eval", "mean_inter",
+    "rel_rmse",
 ]
 
 # Columns the plots read: missing one is an error. The other expected
@@ -337,7 +338,8 @@ def plot_speedup(plt, rows, out_dir):
 
     palette = ["#1f77b4", "#d62728", "#2ca02c", "#ff7f0e", "#9467bd",
                "#8c564b", "#e377c2", "#7f7f7f", "#bcbd22", "#17becf"]
-    kind_style = {"VRL": ("-", "o"), "VPL": ("--", "s")}
+    kind_style = {"VRL": ("-", "o"), "VPL": ("--", "s"),
+                  "VRL-STOCHASTIC": (":", "D")}
 
     fig, ax = plt.subplots(figsize=(8, 5), dpi=110)
     ax.axhline(1.0, color="black", linewidth=1.0, linestyle=":",
@@ -345,7 +347,8 @@ def plot_speedup(plt, rows, out_dir):
 
     def series_key(item):
         scene, kind = item
-        return (scenes.index(scene), {"VRL": 0, "VPL": 1}.get(kind, 2), kind)
+        return (scenes.index(scene),
+                {"VRL": 0, "VRL-STOCHASTIC": 1, "VPL": 2}.get(kind, 3), kind)
 
     for scene, kind in sorted(series, key=series_key):
         points = sorted(series[(scene, kind)])

@@ -76,11 +76,21 @@ struct RunResult {
 };
 
 struct SpeedupResult {
-    std::string scene, kind;
+    std::string scene, kind;  // kind: VRL, VPL (deterministic cuts) or VRL-stochastic
     uint64_t lights = 0;
     double bruteSecondsPerPixel = 0.0, lightcutsSecondsPerPixel = 0.0;
     double meanEval = 0.0, meanInter = 0.0;
+    double error = 0.0;  // the cut's relative RMSE against brute force on these pixels (stochastic: the same, by design)
 };
+
+double relativeRmse(const std::vector<float>& test, const std::vector<float>& reference) {
+    double d2 = 0.0, r2 = 0.0;
+    for (size_t k = 0; k < std::min(test.size(), reference.size()); ++k) {
+        const double d = double(test[k]) - double(reference[k]);
+        d2 += d * d, r2 += double(reference[k]) * reference[k];
+    }
+    return r2 > 0.0 ? std::sqrt(d2 / r2) : NAN;
+}
 
 // The two references of a scene: the whole image (path tracer) and part (d) alone
 // (stochastic VRL Lightcuts over many independent VRL sets).
@@ -379,13 +389,18 @@ std::vector<SpeedupResult> measureSpeedup(const BenchmarkScene& s, const Scene& 
                 const int x = int(index % s.width), y = int(index / s.width);
                 tiles.push_back({x, y, x + 1, y + 1});
             }
-            const auto timeShader = [&](const TileShader& shader, double minimumSeconds, double* eval, double* inter) {
+            const auto timeShader = [&](const TileShader& shader, double minimumSeconds, double* eval, double* inter,
+                                        std::vector<float>* values) {
                 int repeats = 0;
                 double evalSum = 0.0, interSum = 0.0;
                 const auto start = Clock::now();
                 do {
                     std::vector<TileImages> out(tiles.size());
                     tbb::parallel_for(size_t(0), tiles.size(), [&](size_t t) { out[t] = shader.renderTile(tiles[t]); });
+                    if (values && repeats == 0) {  // each pixel's luminance (the tiles are single pixels)
+                        values->clear();
+                        for (const auto& o : out) values->push_back(luminance(o.layers[0][0]));
+                    }
                     ++repeats;
                     if (eval && out[0].layers.size() >= 4) {
                         const size_t layers = out[0].layers.size();
@@ -400,12 +415,52 @@ std::vector<SpeedupResult> measureSpeedup(const BenchmarkScene& s, const Scene& 
             r.scene = s.name;
             r.kind = points ? "VPL" : "VRL";
             r.lights = plainLights.vrls.vrls.size();
-            r.bruteSecondsPerPixel = timeShader(TileShader(scene, plain, plainLights), 0.0, nullptr, nullptr);
-            r.lightcutsSecondsPerPixel = timeShader(TileShader(scene, cuts, cutLights), 0.5, &r.meanEval, &r.meanInter);
-            log.line("%s: speed-up %s N=%llu: brute %.3g s/pixel, Lightcuts %.3g s/pixel -> %.1fx (%d pixels)",
+            std::vector<float> bruteValues, cutValues;
+            r.bruteSecondsPerPixel =
+                timeShader(TileShader(scene, plain, plainLights), 0.0, nullptr, nullptr, &bruteValues);
+            r.lightcutsSecondsPerPixel =
+                timeShader(TileShader(scene, cuts, cutLights), 0.5, &r.meanEval, &r.meanInter, &cutValues);
+            r.error = relativeRmse(cutValues, bruteValues);
+            log.line("%s: speed-up %s N=%llu: brute %.3g s/pixel, Lightcuts %.3g s/pixel -> %.1fx (%d pixels, "
+                     "rel. RMSE %.3g)",
                      s.name.c_str(), r.kind.c_str(), (unsigned long long)r.lights, r.bruteSecondsPerPixel,
-                     r.lightcutsSecondsPerPixel, r.bruteSecondsPerPixel / r.lightcutsSecondsPerPixel, pixels);
+                     r.lightcutsSecondsPerPixel, r.bruteSecondsPerPixel / r.lightcutsSecondsPerPixel, pixels, r.error);
             results.push_back(r);
+            if (points) continue;
+            // Stochastic VRL Lightcuts (K = 32) at the deterministic cut's error: from 16
+            // one-sample passes with their own seeds, the samples per pixel n it needs
+            // for a relative RMSE (against plain VRLs over the same set, which it
+            // estimates without bias) equal to the cut's, n = its relative variance per
+            // sample / error^2 (at least 1), and its time n x the time per sample.
+            RenderSettings stochastic = plain;
+            stochastic.method = RenderMethod::VrlStochastic;
+            stochastic.cut.stochasticCutSize = 32;
+            constexpr int kPasses = 16;
+            std::vector<double> sum(tiles.size(), 0.0), sum2(tiles.size(), 0.0);
+            double perSample = 0.0;
+            for (int p = 0; p < kPasses; ++p) {
+                stochastic.seed = 100 + uint64_t(p);
+                std::vector<float> values;
+                perSample += timeShader(TileShader(scene, stochastic, cutLights), 0.0, nullptr, nullptr, &values) /
+                             kPasses;
+                for (size_t k = 0; k < values.size(); ++k) sum[k] += values[k], sum2[k] += double(values[k]) * values[k];
+            }
+            double variance = 0.0, reference2 = 0.0;
+            for (size_t k = 0; k < tiles.size(); ++k) {
+                const double mean = sum[k] / kPasses;
+                variance += std::max(0.0, sum2[k] / kPasses - mean * mean) * kPasses / (kPasses - 1);
+                reference2 += double(bruteValues[k]) * bruteValues[k];
+            }
+            SpeedupResult st = r;
+            st.kind = "VRL-stochastic";
+            const double samples = reference2 > 0.0 && r.error > 0.0 ? variance / reference2 / (r.error * r.error) : NAN;
+            st.lightcutsSecondsPerPixel = std::isfinite(samples) ? perSample * std::max(1.0, samples) : NAN;
+            st.meanEval = 32.0, st.meanInter = 0.0;
+            st.error = r.error;
+            log.line("%s: speed-up stochastic K=32 N=%llu: %.3g s/pixel per sample, %.3g samples for rel. RMSE %.3g "
+                     "-> %.1fx", s.name.c_str(), (unsigned long long)r.lights, perSample, samples, r.error,
+                     st.bruteSecondsPerPixel / st.lightcutsSecondsPerPixel);
+            results.push_back(st);
         }
     }
     return results;
@@ -668,12 +723,16 @@ void writeSummary(const fs::path& path, const Options& o, const std::vector<Scen
           "are one cut per camera segment.\n\n";
     md << "## Figure 4: speed-up of Lightcuts over brute force\n\n![speed-up](speedup.png)\n\n";
     md << "Multiple scattering (d) only, seconds per pixel on a fixed spread of pixels (brute force: plain VRLs, or "
-          "every VPL at each distance sample).\n\n| scene | lights | N | brute force (ms/pixel) | Lightcuts (ms/pixel) | speed-up | #Eval | #Inter |\n|---|---|---|---|---|---|---|---|\n";
+          "every VPL at each distance sample), at a fixed error: the deterministic cut's (threshold 0.02) relative "
+          "RMSE against brute force on those pixels, which VRL-stochastic (K = 32) is given the samples per pixel "
+          "to match (from the variance of 16 one-sample passes; its time is those samples' time).\n\n"
+          "| scene | lights | N | brute force (ms/pixel) | cut (ms/pixel) | speed-up | rel. RMSE vs brute force | "
+          "#Eval | #Inter |\n|---|---|---|---|---|---|---|---|---|\n";
     for (const auto& r : speedups)
         md << "| " << r.scene << " | " << r.kind << " | " << r.lights << " | " << fmt(1e3 * r.bruteSecondsPerPixel)
            << " | " << fmt(1e3 * r.lightcutsSecondsPerPixel) << " | "
-           << fmt(r.bruteSecondsPerPixel / r.lightcutsSecondsPerPixel) << " | " << fmt(r.meanEval, 4) << " | "
-           << fmt(r.meanInter, 4) << " |\n";
+           << fmt(r.bruteSecondsPerPixel / r.lightcutsSecondsPerPixel) << " | " << fmt(r.error) << " | "
+           << fmt(r.meanEval, 4) << " | " << fmt(r.meanInter, 4) << " |\n";
 }
 
 int runReport(const Options& o) {
@@ -815,12 +874,13 @@ int runReport(const Options& o) {
                 << r.run.cutSize << "," << r.referenceNoiseRmse << "," << (r.belowNoise() ? 1 : 0) << ","
                 << (r.run.multipleOnly ? "multiple" : "image") << "\n";
         std::ofstream sp(o.out / "speedup.csv");
-        sp << "scene,kind,n,brute_seconds_per_pixel,lightcuts_seconds_per_pixel,speedup,mean_eval,mean_inter\n";
+        sp << "scene,kind,n,brute_seconds_per_pixel,lightcuts_seconds_per_pixel,speedup,mean_eval,mean_inter,"
+              "rel_rmse\n";
         sp << std::setprecision(6);
         for (const auto& r : speedups)
             sp << r.scene << "," << r.kind << "," << r.lights << "," << r.bruteSecondsPerPixel << ","
                << r.lightcutsSecondsPerPixel << "," << r.bruteSecondsPerPixel / r.lightcutsSecondsPerPixel << ","
-               << r.meanEval << "," << r.meanInter << "\n";
+               << r.meanEval << "," << r.meanInter << "," << r.error << "\n";
     }
     if (o.buildReferences) {
         log.line("references done in %.1f min (in %s)", secondsSince(start) / 60.0,

@@ -63,7 +63,11 @@ awk -F'|' '/^\| VRL Lightcuts point/ { table = 1; next }
            table && !/^\|/ { table = 0 }
            table && $2 ~ /‡/ { for (i = 4; i < NF; ++i) if ($i !~ /^ *‡ *$/) { print "ratio below noise: " $0; exit 1 } }' \
     "$out/summary.md" || fail "a ratio was given for a run below the noise floor"
-[ "$(grep -c '^bathroom,' "$out/speedup.csv")" -ge 4 ] || fail "speedup.csv rows"
+[ "$(grep -c '^bathroom,' "$out/speedup.csv")" -ge 6 ] || fail "speedup.csv rows"
+# Figure 4 also has the stochastic cut, timed at the deterministic cut's error.
+[ "$(grep -c '^bathroom,VRL-stochastic,' "$out/speedup.csv")" -eq 2 ] || fail "no stochastic speed-up rows"
+awk -F, 'NR > 1 && $2 == "VRL-stochastic" { if (!($5 > 0) || !($9 > 0)) { print "bad stochastic row: " $0; exit 1 } }' \
+    "$out/speedup.csv" || fail "stochastic speed-up rows need a time and an error"
 for heading in "## bathroom" "## Table 1" "## Figure 4" "Equal-time error ratios"; do
     grep -q "$heading" "$out/summary.md" || fail "summary.md lacks '$heading'"
 done
