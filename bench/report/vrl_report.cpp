@@ -525,6 +525,7 @@ struct SceneReport {
     double loadSeconds = 0.0;
     std::string skipped;  // reason, if skipped
     std::map<RenderMethod, std::pair<double, double>> tableStats;  // method -> (#Eval, #Inter)
+    std::pair<double, double> surfaceStats{NAN, NAN};  // VRL Lightcuts' part (c): (#Eval, #Inter) per pixel
     std::vector<std::string> images;  // markdown image lines
 };
 
@@ -708,7 +709,8 @@ void writeSummary(const fs::path& path, const Options& o, const std::vector<Scen
         md << "\n";
     }
     md << "## Table 1: mean #Eval and #Inter per pixel (default threshold, the N stated)\n\n";
-    md << "| scene | N | VPL Lightcuts #Eval | #Inter | VRL Lightcuts #Eval | #Inter |\n|---|---|---|---|---|---|\n";
+    md << "| scene | N | VPL Lightcuts #Eval | #Inter | VRL Lightcuts #Eval | #Inter | VRL Lightcuts, part (c): #Eval | "
+          "#Inter |\n|---|---|---|---|---|---|---|---|\n";
     for (const auto& s : scenes) {
         if (!s.skipped.empty()) continue;
         const auto get = [&](RenderMethod m) {
@@ -717,10 +719,12 @@ void writeSummary(const fs::path& path, const Options& o, const std::vector<Scen
         };
         const auto vpl = get(RenderMethod::VplLightcuts), vrlc = get(RenderMethod::VrlLightcuts);
         md << "| " << s.scene.name << " | " << s.scene.tableLights << " | " << fmt(vpl.first, 4) << " | "
-           << fmt(vpl.second, 4) << " | " << fmt(vrlc.first, 4) << " | " << fmt(vrlc.second, 4) << " |\n";
+           << fmt(vpl.second, 4) << " | " << fmt(vrlc.first, 4) << " | " << fmt(vrlc.second, 4) << " | "
+           << fmt(s.surfaceStats.first, 4) << " | " << fmt(s.surfaceStats.second, 4) << " |\n";
     }
     md << "\nVPL counts are summed over the 32 distance samples of each camera segment (one cut each); VRL counts "
-          "are one cut per camera segment.\n\n";
+          "are one cut per camera segment; part (c), VRL-lit surfaces, one cut per surface point (VPL Lightcuts "
+          "path-sample it).\n\n";
     md << "## Figure 4: speed-up of Lightcuts over brute force\n\n![speed-up](speedup.png)\n\n";
     md << "Multiple scattering (d) only, seconds per pixel on a fixed spread of pixels (brute force: plain VRLs, or "
           "every VPL at each distance sample), at a fixed error: the deterministic cut's (threshold 0.02) relative "
@@ -807,7 +811,9 @@ int runReport(const Options& o) {
                 if ((run.method == RenderMethod::VrlLightcuts || run.method == RenderMethod::VplLightcuts) &&
                     run.lights == s.tableLights && run.errorThreshold == 0.02f) {
                     report.tableStats[run.method] = {stats.meanEvaluated, stats.meanIntersected};
-                    for (const char* counter : {"eval", "inter"}) {
+                    if (run.method == RenderMethod::VrlLightcuts)
+                        report.surfaceStats = {stats.surfaceMeanEvaluated, stats.surfaceMeanIntersected};
+                    for (const char* counter : {"eval", "inter", "medium-surface-eval", "medium-surface-inter"}) {
                         if (const Image* layer = layerOf(images, counter))
                             lastOfMethod[std::string(methodName(run.method)) + "/" + counter] = ImageSet{*layer, {}, {}, {}};
                     }
@@ -855,6 +861,18 @@ int runReport(const Options& o) {
                     report.images.push_back("|---|---|---|");
                 }
                 report.images.push_back(line);
+            }
+            // Part (c)'s cuts (VRL Lightcuts only), each counter on its own scale.
+            for (const char* counter : {"medium-surface-eval", "medium-surface-inter"}) {
+                const auto it = lastOfMethod.find(std::string("vrl-lightcuts/") + counter);
+                if (it == lastOfMethod.end()) continue;
+                const float clip = percentileValue(it->second.image, 0.98f);
+                const std::string file = safeName(s.name) + "-vrl-lightcuts-" + counter + ".png";
+                writeFalseColourPng(it->second.image, clip, o.out / "images" / file);
+                report.images.push_back("| part (c) #" +
+                                        std::string(counter == std::string("medium-surface-eval") ? "Eval" : "Inter") +
+                                        " (scale 0 to " + fmt(clip, 4) + ") | | ![VRL Lightcuts, part (c)](images/" +
+                                        file + ") |");
             }
             const auto measured = measureSpeedup(s, *scene, log);
             speedups.insert(speedups.end(), measured.begin(), measured.end());

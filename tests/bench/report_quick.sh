@@ -73,6 +73,9 @@ for heading in "## bathroom" "## Table 1" "## Figure 4" "Equal-time error ratios
 done
 # Table 1 has numbers for both Lightcuts.
 grep -E '^\| bathroom \| 10000 \| [0-9]' "$out/summary.md" >/dev/null || fail "Table 1 row"
+# ... and part (c)'s counts (the last two cells), with its false-colour images.
+grep -E '^\| bathroom \| 10000 \|.*\| [0-9.e+]+ \| [0-9.e+]+ \|$' "$out/summary.md" >/dev/null || fail "Table 1: part (c)"
+[ -s "$out/images/bathroom-vrl-lightcuts-medium-surface-eval.png" ] || fail "no part (c) #Eval image"
 # A second run takes the reference from the cache.
 second=$("$report" --quick --no-plots -o "$out" 2>&1) || fail "the second run failed: $second"
 grep -q "reference from the cache" <<<"$second" || fail "the reference was not cached"
