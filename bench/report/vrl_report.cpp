@@ -1,12 +1,16 @@
 // vrl_report: error against run time for every method on the benchmark scenes
-// (Vibert et al. 2019, Figures 3, 4, 6 and Table 1). For each scene: a
-// path-traced reference (two independent halves, cached by a hash of the
-// scene's files and the settings; their difference estimates its noise), then
-// every method over a range of settings, recording wall time (light tracing,
-// tree build and shading; the scene load is common to all and left out),
-// RMSE, relative RMSE, SMAPE and the cut statistics. Writes results.csv,
-// speedup.csv, false-colour #Eval / #Inter images, previews, summary.md and
-// (through bench/plot_report.py) the plots.
+// (Vibert et al. 2019, Figures 3, 4, 6 and Table 1). For each scene: two
+// references, the whole image (path tracer) and part (d) alone (stochastic VRL
+// Lightcuts over independent VRL sets), each two independent halves whose
+// difference estimates its noise, rendered in resumable chunks and kept in
+// bench/references by a hash of the scene's files, the settings and the method;
+// then every method over a range of settings, for the whole image and for part
+// (d) alone, recording wall time (light tracing, tree build and shading; the
+// scene load is common to all and left out), RMSE, relative RMSE, SMAPE and the
+// cut statistics, with the noise rule (an error below 3x the reference's own
+// is marked and left out of every ratio). Writes results.csv, speedup.csv,
+// false-colour #Eval / #Inter images, previews, summary.md (tables, ratios,
+// verdicts) and (through bench/plot_report.py) the plots.
 #include "bench/report/benchmark_scenes.h"
 #include "bench/report/curve_ratios.h"
 #include "bench/report/false_colour.h"
@@ -922,10 +926,11 @@ int runReport(const Options& o) {
 }  // namespace
 
 int main(int argc, char** argv) {
-    CLI::App app{"vrl_report: error against run time for path tracing, plain VRLs, VRL Lightcuts and VPL Lightcuts "
-                 "on the benchmark scenes (CSV, plots, false-colour statistics, Markdown summary)"};
+    CLI::App app{"vrl_report: error against run time for path tracing, plain VRLs, VRL Lightcuts, stochastic VRL "
+                 "Lightcuts and VPL Lightcuts on the benchmark scenes, for the whole image and part (d) alone (CSV, "
+                 "plots, false-colour statistics, Markdown summary)"};
     Options o;
-    app.add_option("-o,--out", o.out, "Output folder (created); references are cached in OUT/cache (default report)");
+    app.add_option("-o,--out", o.out, "Output folder (created; default report)");
     app.add_flag("--quick", o.quick, "A small version (our own scene at 32x24, short sweeps): under 3 minutes; its "
                                      "references go to OUT/cache");
     app.add_flag("--references", o.buildReferences,
