@@ -170,7 +170,8 @@ Rgb walkCut(const LightTree& tree, const CutSettings& settings, CutStatistics& s
         for (int refined = 0; refined < kRefineBatch && !heap.empty(); ++refined) {
             const CutScratch::CutNode top = heap.front();
             if (top.bound <= threshold) break;
-            if (heap.size() + leavesInCut + 2 * size_t(refined) >= settings.maxCutSize) break;  // the cut after `refined` refinements
+            // The cut's size after `refined` refinements of this batch (each adds one node).
+            if (heap.size() + leavesInCut + 2 * size_t(refined) >= settings.maxCutSize) break;
             std::pop_heap(heap.begin(), heap.end());
             heap.pop_back();
             total -= top.estimate;
