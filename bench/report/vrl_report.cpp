@@ -87,13 +87,15 @@ struct SpeedupResult {
     double error = 0.0;  // the cut's relative RMSE against brute force on these pixels (stochastic: the same, by design)
 };
 
+// The report's relative RMSE (image_metrics.h: per pixel against R^2 + eps) of
+// per-pixel luminances.
 double relativeRmse(const std::vector<float>& test, const std::vector<float>& reference) {
-    double d2 = 0.0, r2 = 0.0;
-    for (size_t k = 0; k < std::min(test.size(), reference.size()); ++k) {
-        const double d = double(test[k]) - double(reference[k]);
-        d2 += d * d, r2 += double(reference[k]) * reference[k];
-    }
-    return r2 > 0.0 ? std::sqrt(d2 / r2) : NAN;
+    const auto row = [](const std::vector<float>& values) {
+        Image image(int(values.size()), 1);
+        for (size_t k = 0; k < values.size(); ++k) image[k] = Rgb(values[k]);  // grey: its luminance is the value
+        return image;
+    };
+    return compareImages(row(reference), row(test)).relativeRmse;
 }
 
 // The two references of a scene: the whole image (path tracer) and part (d) alone
@@ -449,15 +451,17 @@ std::vector<SpeedupResult> measureSpeedup(const BenchmarkScene& s, const Scene& 
                              kPasses;
                 for (size_t k = 0; k < values.size(); ++k) sum[k] += values[k], sum2[k] += double(values[k]) * values[k];
             }
-            double variance = 0.0, reference2 = 0.0;
+            // Its expected relative MSE per sample, weighted as the metric weighs each pixel.
+            double relativeVariance = 0.0;
             for (size_t k = 0; k < tiles.size(); ++k) {
-                const double mean = sum[k] / kPasses;
-                variance += std::max(0.0, sum2[k] / kPasses - mean * mean) * kPasses / (kPasses - 1);
-                reference2 += double(bruteValues[k]) * bruteValues[k];
+                const double mean = sum[k] / kPasses, reference = bruteValues[k];
+                relativeVariance += std::max(0.0, sum2[k] / kPasses - mean * mean) * kPasses / (kPasses - 1) /
+                                    (reference * reference + kMetricEpsilon);
             }
+            relativeVariance /= double(tiles.size());
             SpeedupResult st = r;
             st.kind = "VRL-stochastic";
-            const double samples = reference2 > 0.0 && r.error > 0.0 ? variance / reference2 / (r.error * r.error) : NAN;
+            const double samples = r.error > 0.0 ? relativeVariance / (r.error * r.error) : NAN;
             st.lightcutsSecondsPerPixel = std::isfinite(samples) ? perSample * std::max(1.0, samples) : NAN;
             st.meanEval = 32.0, st.meanInter = 0.0;
             st.error = r.error;
