@@ -260,17 +260,21 @@ Image referenceImage(const BenchmarkScene& s, const Scene& scene, ReferencePart 
             }
             ++done;
             log.line("%s: %s: chunk %d of %d", s.name.c_str(), what.c_str(), done, chunks);
-            // At the time limit (after at least one chunk, so that every run makes progress):
-            // keep the chunks for the next run.
-            if (done < chunks && minutes > 0.0 && secondsSince(start) > 60.0 * minutes) {
-                ImageSet save;
-                save.image = halves[0];
-                save.layers = {{"half1", halves[0]}, {"half2", halves[1]}};
-                save.metadata["vrl.report.key"] = key;
-                save.metadata["vrl.report.chunks"] = int32_t(done);
-                save.metadata["vrl.report.seconds"] = seconds + secondsSince(start);
-                fs::create_directories(dir);
-                writeExr(partial, save);
+            if (done == chunks) break;
+            // Every chunk is kept (written beside, then renamed: a run killed at any
+            // moment loses at most the chunk it was rendering); a later run resumes.
+            ImageSet save;
+            save.image = halves[0];
+            save.layers = {{"half1", halves[0]}, {"half2", halves[1]}};
+            save.metadata["vrl.report.key"] = key;
+            save.metadata["vrl.report.chunks"] = int32_t(done);
+            save.metadata["vrl.report.seconds"] = seconds + secondsSince(start);
+            fs::create_directories(dir);
+            const fs::path writing = fs::path(partial).concat(".writing");
+            writeExr(writing, save);
+            fs::rename(writing, partial);
+            // At the time limit (after at least one chunk, so that every run makes progress): stop.
+            if (minutes > 0.0 && secondsSince(start) > 60.0 * minutes) {
                 log.line("%s: %s stopped at the time limit after %d of %d chunks (kept in %s; run again to go on)",
                          s.name.c_str(), what.c_str(), done, chunks, partial.filename().c_str());
                 info.incomplete = true;
@@ -645,6 +649,86 @@ void writeComparison(std::ostream& md, const std::vector<RunResult>& results, co
     md << "\n" << verdict(results, name, multipleOnly) << "\n\n";
 }
 
+// "What to use when", from the measured curves: for each scene and part, at a
+// few time budgets, the method (curve) with the lowest RMSE at that time among
+// those whose measured range (above the noise rule's floor) holds it, with the
+// runner-up's error as a multiple of the winner's; then, per method, where it won.
+void writeWhatToUseWhen(std::ostream& md, const std::vector<RunResult>& results,
+                        const std::vector<SceneReport>& scenes) {
+    // Budgets 0.1, 0.3, 1, 3, ... 300 s; the columns shown are those where some row has a winner.
+    const std::vector<double> budgets = {0.1, 0.3, 1.0, 3.0, 10.0, 30.0, 100.0, 300.0};
+    struct Row {
+        std::string scene, part;
+        std::vector<std::string> cells;  // per budget; empty: no winner
+    };
+    std::vector<Row> rows;
+    std::vector<bool> shown(budgets.size(), false);
+    std::map<std::string, std::vector<std::string>> wins;  // method -> "scene part at t"
+    int cells = 0;
+    for (const auto& s : scenes) {
+        if (!s.skipped.empty()) continue;
+        for (const bool multipleOnly : {false, true}) {
+            std::vector<std::string> curves;
+            for (const auto& r : results)
+                if (r.scene == s.scene.name && r.run.multipleOnly == multipleOnly &&
+                    std::find(curves.begin(), curves.end(), r.run.curve()) == curves.end())
+                    curves.push_back(r.run.curve());
+            if (curves.empty()) continue;
+            const auto title = [&](const std::string& curve) {  // without the part's "(d) "
+                return curveTitle(multipleOnly ? curve.substr(4) : curve);
+            };
+            Row row{s.scene.name, multipleOnly ? "(d) alone" : "whole image", {}};
+            for (size_t b = 0; b < budgets.size(); ++b) {
+                std::vector<std::pair<double, std::string>> at;  // (RMSE at the budget, curve)
+                for (const auto& c : curves)
+                    if (const auto e = errorAtTime(curveOf(results, s.scene.name, c, false), budgets[b]))
+                        at.push_back({*e, c});
+                if (at.size() < 2) {
+                    row.cells.emplace_back();
+                    continue;
+                }
+                std::sort(at.begin(), at.end());
+                const std::string winner = title(at[0].second);
+                row.cells.push_back("**" + winner + "** (" + fmt(at[0].first) + "; " + title(at[1].second) + " ×" +
+                                    fmt(at[1].first / at[0].first) + ")");
+                wins[winner].push_back(row.scene + " " + row.part + " at " + fmt(budgets[b]) + " s");
+                shown[b] = true;
+                ++cells;
+            }
+            rows.push_back(std::move(row));
+        }
+    }
+    md << "## What to use when\n\nFrom the curves above: at each time budget, the method with the lowest RMSE at "
+          "that time (interpolated between its measured points, never extrapolated; runs below the noise rule's "
+          "floor left out), and the runner-up's RMSE as a multiple of the winner's; '—': fewer than two methods "
+          "were measured at that time. A method's curve is one setting (threshold e or cut size K) over N and spp, "
+          "so the table also says which setting to use.\n\n";
+    if (cells == 0) {
+        md << "No time budget had two methods measured above the noise floor.\n\n";
+        return;
+    }
+    md << "| scene | part |";
+    for (size_t b = 0; b < budgets.size(); ++b)
+        if (shown[b]) md << " at " << fmt(budgets[b]) << " s |";
+    md << "\n|---|---|";
+    for (size_t b = 0; b < budgets.size(); ++b)
+        if (shown[b]) md << "---|";
+    md << "\n";
+    for (const auto& row : rows) {
+        md << "| " << row.scene << " | " << row.part << " |";
+        for (size_t b = 0; b < budgets.size(); ++b)
+            if (shown[b]) md << " " << (row.cells[b].empty() ? "—" : row.cells[b]) << " |";
+        md << "\n";
+    }
+    md << "\n";
+    for (const auto& [method, where] : wins) {
+        md << "- **" << method << "** has the lowest error in " << where.size() << " of " << cells << " cells: ";
+        for (size_t k = 0; k < where.size(); ++k) md << (k ? ", " : "") << where[k];
+        md << ".\n";
+    }
+    md << "\n";
+}
+
 void writeSummary(const fs::path& path, const Options& o, const std::vector<SceneReport>& scenes,
                   const std::vector<RunResult>& results, const std::vector<SpeedupResult>& speedups,
                   double totalSeconds, int threads) {
@@ -678,10 +762,14 @@ void writeSummary(const fs::path& path, const Options& o, const std::vector<Scen
             continue;
         }
         md << "| " << s.scene.name << " | " << s.scene.description << (s.scene.medium.empty() ? "" : " (`--medium " + s.scene.medium + "`)")
-           << " | " << s.scene.width << "x" << s.scene.height << " | " << s.reference.spp << " spp, "
-           << fmt(s.reference.seconds, 4) << " s" << (s.reference.cached ? " (cached)" : "") << " | "
-           << fmt(s.reference.noiseRmse) << " / " << fmt(s.reference.noiseRelativeRmse) << " / "
-           << fmt(s.reference.noiseSmape) << " | " << s.partReference.method << ", " << fmt(s.partReference.seconds, 4)
+           << " | " << s.scene.width << "x" << s.scene.height << " | ";
+        if (s.reference.spp > 0)
+            md << s.reference.spp << " spp, " << fmt(s.reference.seconds, 4) << " s"
+               << (s.reference.cached ? " (cached)" : "") << " | " << fmt(s.reference.noiseRmse) << " / "
+               << fmt(s.reference.noiseRelativeRmse) << " / " << fmt(s.reference.noiseSmape) << " | ";
+        else
+            md << "none (part (d) alone) | | ";
+        md << s.partReference.method << ", " << fmt(s.partReference.seconds, 4)
            << " s" << (s.partReference.cached ? " (cached)" : "") << " | " << fmt(s.partReference.noiseRmse) << " / "
            << fmt(s.partReference.noiseRelativeRmse) << " / " << fmt(s.partReference.noiseSmape) << " |\n";
     }
@@ -705,8 +793,12 @@ void writeSummary(const fs::path& path, const Options& o, const std::vector<Scen
     for (const auto& s : scenes) {
         if (!s.skipped.empty()) continue;
         const std::string& name = s.scene.name;
-        md << "## " << name << "\n\n### The whole image\n\n";
-        writeComparison(md, results, name, false);
+        md << "## " << name << "\n\n";
+        if (std::any_of(results.begin(), results.end(),
+                        [&](const RunResult& r) { return r.scene == name && !r.run.multipleOnly; })) {
+            md << "### The whole image\n\n";
+            writeComparison(md, results, name, false);
+        }
         md << "### Part (d) alone (multiple scattering: the paper's Figure 3 comparison)\n\n"
            << "Against the part (d) reference; parts (a)-(c) are off, so only the virtual lights' own error counts. "
               "Plain VRLs, VRL and VPL Lightcuts at 1 spp (rays through pixel centres: more samples only redraw the "
@@ -716,6 +808,7 @@ void writeSummary(const fs::path& path, const Options& o, const std::vector<Scen
         for (const auto& line : s.images) md << line << "\n";
         md << "\n";
     }
+    writeWhatToUseWhen(md, results, scenes);
     md << "## Table 1: mean #Eval and #Inter per pixel (default threshold, the N stated)\n\n";
     md << "| scene | N | VPL Lightcuts #Eval | #Inter | VRL Lightcuts #Eval | #Inter | VRL Lightcuts, part (c): #Eval | "
           "#Inter |\n|---|---|---|---|---|---|---|---|\n";
@@ -782,18 +875,25 @@ int runReport(const Options& o) {
             const fs::path referenceDir = o.quick ? o.out / "cache" : o.references;
             const double minutes = o.buildReferences ? o.referenceMinutes : 0.0;
             const auto referenceStart = Clock::now();
+            // A scene measured on part (d) alone needs no whole-image reference.
+            const bool wholeImage =
+                std::any_of(s.runs.begin(), s.runs.end(), [](const MethodRun& r) { return !r.multipleOnly; });
             const Image reference =
-                referenceImage(s, *scene, ReferencePart::Image, referenceDir, log, report.reference, minutes);
+                wholeImage ? referenceImage(s, *scene, ReferencePart::Image, referenceDir, log, report.reference, minutes)
+                           : Image();
             const double left = minutes > 0.0 ? std::max(1e-9, minutes - secondsSince(referenceStart) / 60.0) : 0.0;
             const Image partReference =
                 referenceImage(s, *scene, ReferencePart::Multiple, referenceDir, log, report.partReference, left);
             if (o.buildReferences) return;
             if (scenes.empty())  // the first scene: the part (d) reference against plain VRLs over independent sets
                 report.partCheck = checkPartReference(s, *scene, partReference, report.partReference, 16,
-                                                      o.quick ? 3000 : 2000, log);
-            const float exposure = autoExposure(reference);
-            writePreviewPng(reference, o.out / "images" / (safeName(s.name) + "-reference.png"), exposure);
-            report.images.push_back("Reference and the largest setting of each method (same exposure):\n");
+                                                      o.quick ? 3000 : 1000, log);
+            // The previews show the whole image, or part (d) where that is all a scene measures.
+            const Image& shown = wholeImage ? reference : partReference;
+            const float exposure = autoExposure(shown);
+            writePreviewPng(shown, o.out / "images" / (safeName(s.name) + "-reference.png"), exposure);
+            report.images.push_back(std::string(wholeImage ? "Reference" : "Part (d): its reference") +
+                                    " and the largest setting of each method (same exposure):\n");
             std::string row = "| reference |", header = "|---|";
             std::string imageRow = "| ![](images/" + safeName(s.name) + "-reference.png) |";
             std::map<std::string, ImageSet> lastOfMethod;
@@ -812,19 +912,26 @@ int runReport(const Options& o) {
                          totalRuns, std::string(methodName(run.method)).c_str(), run.label().c_str(), r.seconds, r.metrics.rmse,
                          r.metrics.relativeRmse, r.metrics.smape, r.belowNoise() ? "  (below the reference's noise)" : "",
                          r.metrics.nonFinitePixels ? "  (NON-FINITE PIXELS)" : "");
-                if (run.multipleOnly) {
-                    results.push_back(std::move(r));
-                    continue;
-                }
-                if ((run.method == RenderMethod::VrlLightcuts || run.method == RenderMethod::VplLightcuts) &&
-                    run.lights == s.tableLights && run.errorThreshold == 0.02f) {
+                // Table 1 and Figure 6: part (d)'s cuts from the (d)-alone runs, part (c)'s
+                // from the whole image's, both Lightcuts at the default threshold and N.
+                const bool tableRun = (run.method == RenderMethod::VrlLightcuts ||
+                                       run.method == RenderMethod::VplLightcuts) &&
+                                      run.lights == s.tableLights && run.errorThreshold == 0.02f;
+                if (tableRun && run.multipleOnly) {
                     report.tableStats[run.method] = {stats.meanEvaluated, stats.meanIntersected};
-                    if (run.method == RenderMethod::VrlLightcuts)
-                        report.surfaceStats = {stats.surfaceMeanEvaluated, stats.surfaceMeanIntersected};
-                    for (const char* counter : {"eval", "inter", "medium-surface-eval", "medium-surface-inter"}) {
+                    for (const char* counter : {"eval", "inter"})
                         if (const Image* layer = layerOf(images, counter))
                             lastOfMethod[std::string(methodName(run.method)) + "/" + counter] = ImageSet{*layer, {}, {}, {}};
-                    }
+                }
+                if (tableRun && !run.multipleOnly && run.method == RenderMethod::VrlLightcuts) {
+                    report.surfaceStats = {stats.surfaceMeanEvaluated, stats.surfaceMeanIntersected};
+                    for (const char* counter : {"medium-surface-eval", "medium-surface-inter"})
+                        if (const Image* layer = layerOf(images, counter))
+                            lastOfMethod[std::string("vrl-lightcuts/") + counter] = ImageSet{*layer, {}, {}, {}};
+                }
+                if (run.multipleOnly == wholeImage) {  // not the part the previews show
+                    results.push_back(std::move(r));
+                    continue;
                 }
                 if (run.method != RenderMethod::VrlLightcuts || run.errorThreshold == 0.02f) {
                     lastOfMethod[std::string(methodName(run.method))] = ImageSet{images.image, {}, {}, {}};
@@ -864,7 +971,7 @@ int runReport(const Options& o) {
                 }
                 if (counter == std::string("eval")) {
                     report.images.push_back("Figure 6 (N = " + std::to_string(s.tableLights) +
-                                            "): left VPL Lightcuts, right VRL Lightcuts.\n");
+                                            ", part (d)'s cuts): left VPL Lightcuts, right VRL Lightcuts.\n");
                     report.images.push_back("| counter | VPL Lightcuts | VRL Lightcuts |");
                     report.images.push_back("|---|---|---|");
                 }

@@ -68,6 +68,11 @@ awk -F'|' '/^\| VRL Lightcuts point/ { table = 1; next }
 [ "$(grep -c '^bathroom,VRL-stochastic,' "$out/speedup.csv")" -eq 2 ] || fail "no stochastic speed-up rows"
 awk -F, 'NR > 1 && $2 == "VRL-stochastic" { if (!($5 > 0) || !($9 > 0)) { print "bad stochastic row: " $0; exit 1 } }' \
     "$out/speedup.csv" || fail "stochastic speed-up rows need a time and an error"
+# "What to use when": a winner at some time budget, and where each winning method won.
+sed -n '/^## What to use when/,/^## Table 1/p' "$out/summary.md" | grep -qE '^\| bathroom \| whole image \|.*\*\*' \
+    || fail "summary.md: no winner in 'What to use when'"
+grep -qE '^- \*\*.*\*\* has the lowest error in [0-9]+ of [0-9]+ cells' "$out/summary.md" \
+    || fail "summary.md: 'What to use when' does not say where each method won"
 for heading in "## bathroom" "## Table 1" "## Figure 4" "Equal-time error ratios"; do
     grep -q "$heading" "$out/summary.md" || fail "summary.md lacks '$heading'"
 done
