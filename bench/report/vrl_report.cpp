@@ -389,9 +389,11 @@ std::vector<SpeedupResult> measureSpeedup(const BenchmarkScene& s, const Scene& 
             RenderLights plainLights = prepareLights(scene, plain);
             RenderLights cutLights;
             cutLights.tree = LightTree::build(plainLights.vrls.vrls, LightTreeSettings{cuts.partitionSize, cuts.seed, points});
-            // Brute force costs N (VRLs) or 32 N (VPLs) terms per pixel: keep it to ~3e7 terms.
+            // Brute force costs N (VRLs) or 32 N (VPLs) terms per pixel: keep it to ~3e7 terms,
+            // with at least 8 pixels for the VRLs (their error feeds the stochastic cut's
+            // samples) and 2 for the VPLs (10^7 VPLs: 3.2e8 terms a pixel).
             const double terms = double(plainLights.vrls.vrls.size()) * (points ? 32.0 : 1.0);
-            const int pixels = int(std::clamp(3e7 / std::max(1.0, terms), 8.0, 2048.0));
+            const int pixels = int(std::clamp(3e7 / std::max(1.0, terms), points ? 2.0 : 8.0, 2048.0));
             std::vector<TileRect> tiles;
             const int total = s.width * s.height;
             for (int k = 0; k < pixels; ++k) {
