@@ -169,24 +169,28 @@ RenderSettings settingsFor(const BenchmarkScene& s, const MethodRun& run, uint64
     return settings;
 }
 
-// A reference half is rendered in kReferenceChunks chunks of equal spp, each with
-// its own seed (so its own random streams and, for part (d), its own VRL sets),
-// saved after each chunk: a long reference can be built over several runs.
+// A reference half is rendered in kReferenceChunks chunks, each with its own
+// seeds (so its own random streams and, for part (d), its own VRL sets), saved
+// after each chunk: a long reference can be built over several runs.
 constexpr int kReferenceChunks = 8;
 
-// The settings of chunk `chunk` of one half of a reference.
-RenderSettings referenceSettings(const BenchmarkScene& s, ReferencePart part, uint64_t half, int chunk) {
-    const uint64_t seed = 2 * uint64_t(chunk) + half;  // the halves and chunks: disjoint streams
+// The renders of chunk `chunk` of one half of a reference, whose mean is the
+// chunk: the path tracer's one render, or part (d)'s one per VRL set (plain
+// VRLs, each set traced from its own seed, so the mean converges to the true
+// transport, not one set's).
+std::vector<RenderSettings> referenceChunk(const BenchmarkScene& s, ReferencePart part, uint64_t half, int chunk) {
+    const uint64_t stream = 2 * uint64_t(chunk) + half;  // the halves and chunks: disjoint streams
     if (part == ReferencePart::Image)
-        return settingsFor(s, MethodRun{RenderMethod::Path, 0, std::max(1, s.referenceSpp / 2 / kReferenceChunks)},
-                           1000003 + seed);
-    RenderSettings settings = settingsFor(
-        s, MethodRun{RenderMethod::VrlStochastic, s.partReferenceVrls,
-                     std::max(1, s.partReferenceSpp / kReferenceChunks), 0.02f, 32},
-        2000003 + seed);  // the seed also keys the chunk's VRL sets: independent
-    settings.transports = TransportSelection::parse("multiple");
-    settings.vrlSets = s.partReferenceSets;
-    return settings;
+        return {settingsFor(s, MethodRun{RenderMethod::Path, 0, std::max(1, s.referenceSpp / 2 / kReferenceChunks)},
+                            1000003 + stream)};
+    std::vector<RenderSettings> sets;
+    for (int k = 0; k < s.partReferenceSets; ++k) {
+        RenderSettings settings =
+            settingsFor(s, MethodRun{RenderMethod::Vrl, s.partReferenceVrls, 1}, 2000003 + stream * 4096 + uint64_t(k));
+        settings.transports = TransportSelection::parse("multiple");
+        sets.push_back(settings);
+    }
+    return sets;
 }
 
 std::string gitCommit() {
@@ -207,24 +211,23 @@ std::string gitCommit() {
 // a text file beside it with the settings, the code version and the estimated noise.
 Image referenceImage(const BenchmarkScene& s, const Scene& scene, ReferencePart part, const fs::path& dir,
                      const Log& log, ReferenceInfo& info, double minutes = 0.0) {
-    const RenderSettings first = referenceSettings(s, part, 0, 0);
+    const RenderSettings first = referenceChunk(s, part, 0, 0).front();
     const bool image = part == ReferencePart::Image;
     const std::string what = image ? "reference" : "part (d) reference";
     const int chunks = kReferenceChunks;
     const int perHalf = chunks * first.samplesPerPixel;
+    const int sets = 2 * chunks * s.partReferenceSets;  // part (d): VRL sets in all
     std::string key = image ? "path spp=" + std::to_string(first.samplesPerPixel) + "x" + std::to_string(chunks) + "x2"
-                            : "vrl-stochastic transports=multiple K=32 vrls=" + std::to_string(first.vrlCount) +
-                                  " sets=" + std::to_string(first.vrlSets) + " spp=" +
-                                  std::to_string(first.samplesPerPixel) + "x" + std::to_string(chunks) + "x2";
+                            : "vrl transports=multiple vrls=" + std::to_string(first.vrlCount) + " spp=1 sets=" +
+                                  std::to_string(s.partReferenceSets) + "x" + std::to_string(chunks) + "x2";
     key += " maxDepth=" + std::to_string(s.maxDepth) + " size=" + std::to_string(s.width) + "x" +
            std::to_string(s.height) + " medium=" + s.medium + " version=" + VRL_VERSION;
     const fs::path file =
         dir / (s.name + (image ? "-reference-" : "-reference-d-") + hashSceneAndSettings(s, key) + ".exr");
     info.part = part;
     info.method = image ? "path tracer, " + std::to_string(2 * perHalf) + " spp"
-                        : "stochastic VRL Lightcuts (K = 32), " + std::to_string(2 * chunks * first.vrlSets) +
-                              " VRL sets of " + std::to_string(first.vrlCount) + ", " + std::to_string(2 * perHalf) +
-                              " spp";
+                        : "plain VRLs over " + std::to_string(sets) + " independent VRL sets of " +
+                              std::to_string(first.vrlCount);
     info.spp = 2 * perHalf;
     info.file = file;
     ImageSet set;
@@ -254,7 +257,12 @@ Image referenceImage(const BenchmarkScene& s, const Scene& scene, ReferencePart 
         const auto start = Clock::now();
         while (done < chunks) {
             for (uint64_t h = 0; h < 2; ++h) {
-                const Image chunk = render(scene, referenceSettings(s, part, h, done)).image;
+                const std::vector<RenderSettings> renders = referenceChunk(s, part, h, done);
+                Image chunk(s.width, s.height);
+                for (const RenderSettings& settings : renders) {
+                    const Image one = render(scene, settings).image;
+                    for (size_t i = 0; i < one.pixelCount(); ++i) chunk[i] = chunk[i] + one[i] * (1.0f / float(renders.size()));
+                }
                 for (size_t i = 0; i < chunk.pixelCount(); ++i)  // the running mean of the chunks
                     halves[h][i] = halves[h][i] + (chunk[i] - halves[h][i]) * (1.0f / float(done + 1));
             }
@@ -295,6 +303,7 @@ Image referenceImage(const BenchmarkScene& s, const Scene& scene, ReferencePart 
         record.settings.samplesPerPixel = 2 * perHalf;  // the chunks of the two halves together
         record.statistics.seconds = info.seconds;
         record.run = {{"halves", int32_t(2)}, {"chunks", int32_t(chunks)}};
+        if (!image) record.run["vrlSets"] = int32_t(sets);
         writeRenderMetadata(record, scene.camera(), set.metadata);
         set.metadata["vrl.report.key"] = key;
         set.metadata["vrl.report.seconds"] = info.seconds;
@@ -330,28 +339,30 @@ Image referenceImage(const BenchmarkScene& s, const Scene& scene, ReferencePart 
     return set.image;
 }
 
-// The part (d) reference against an independent estimate of the same quantity:
-// plain VRLs averaged over `sets` independent VRL sets of `vrls` VRLs (also
-// unbiased for the true transport). Their difference's RMSE (on luminance) is
-// compared with what their two noises predict, sqrt(noise_ref^2 + noise_plain^2),
-// the plain mean's noise from the spread of its sets.
+// The part (d) reference against an independent estimate of the same quantity
+// by another method: stochastic VRL Lightcuts (K = 32) averaged over `sets`
+// renders, each from its own VRL set (also unbiased for the true transport).
+// Their difference's RMSE (on luminance) is compared with what their two noises
+// predict, sqrt(noise_ref^2 + noise_check^2), the check's noise from the spread
+// of its renders.
 struct ReferenceCheck {
-    int sets = 0;
+    int sets = 0, spp = 0;
     uint64_t vrls = 0;
     double differenceRmse = 0.0, expectedRmse = 0.0, seconds = 0.0;
-    double plainNoiseRmse = 0.0;  // of the plain mean
+    double checkNoiseRmse = 0.0;  // of the check's mean
     bool done() const { return sets > 0; }
 };
 
 ReferenceCheck checkPartReference(const BenchmarkScene& s, const Scene& scene, const Image& reference,
-                                  const ReferenceInfo& info, int sets, uint64_t vrls, const Log& log) {
+                                  const ReferenceInfo& info, int sets, uint64_t vrls, int spp, const Log& log) {
     ReferenceCheck c;
-    c.sets = sets, c.vrls = vrls;
+    c.sets = sets, c.vrls = vrls, c.spp = spp;
     const auto start = Clock::now();
     const size_t n = size_t(s.width) * size_t(s.height);
     std::vector<double> sum(n, 0.0), sum2(n, 0.0);
     for (int k = 0; k < sets; ++k) {
-        RenderSettings settings = settingsFor(s, MethodRun{RenderMethod::Vrl, vrls, 1}, 3000017 + uint64_t(k));
+        RenderSettings settings =
+            settingsFor(s, MethodRun{RenderMethod::VrlStochastic, vrls, spp, 0.02f, 32}, 3000017 + uint64_t(k));
         settings.transports = TransportSelection::parse("multiple");
         const Image image = render(scene, settings).image;
         for (size_t i = 0; i < n; ++i) {
@@ -367,10 +378,10 @@ ReferenceCheck checkPartReference(const BenchmarkScene& s, const Scene& scene, c
         difference2 += d * d;
     }
     c.differenceRmse = std::sqrt(difference2 / double(n));
-    c.plainNoiseRmse = std::sqrt(variance / double(n));
+    c.checkNoiseRmse = std::sqrt(variance / double(n));
     c.expectedRmse = std::sqrt(info.noiseRmse * info.noiseRmse + variance / double(n));
     c.seconds = secondsSince(start);
-    log.line("%s: part (d) reference check: plain VRLs over %d sets of %llu: RMSE of the difference %.4g, expected "
+    log.line("%s: part (d) reference check: stochastic VRL Lightcuts over %d sets of %llu: RMSE of the difference %.4g, expected "
              "from the noises %.4g (ratio %.2f)", s.name.c_str(), sets, (unsigned long long)vrls, c.differenceRmse,
              c.expectedRmse, c.differenceRmse / c.expectedRmse);
     return c;
@@ -607,6 +618,10 @@ void writeComparison(std::ostream& md, const std::vector<RunResult>& results, co
     std::vector<std::string> others = {"vrl", "vrl-stochastic K=8", "vrl-stochastic K=32", "vpl-lightcuts e=0.02"};
     if (!multipleOnly) others.push_back("path");
     for (auto& o : others) o = prefix + o;
+    std::erase_if(others, [&](const std::string& curve) {  // a curve this part does not measure
+        return std::none_of(results.begin(), results.end(),
+                            [&](const RunResult& r) { return r.scene == name && r.run.curve() == curve; });
+    });
     const std::string recommended = prefix + "vrl-lightcuts e=0.02";
     md << "![error against time](error-time-" << safeName(name) << (multipleOnly ? "-d" : "") << ".png)\n\n";
     md << "| method | settings | time (s) | RMSE | RMSE / reference noise | rel. RMSE | SMAPE | mean ratio | #Eval | #Inter "
@@ -780,17 +795,18 @@ void writeSummary(const fs::path& path, const Options& o, const std::vector<Scen
         if (!s.partCheck.done()) continue;
         const ReferenceCheck& c = s.partCheck;
         const double ratio = c.differenceRmse / c.expectedRmse;
-        md << "**Part (d) reference check** (" << s.scene.name << "): the part (d) reference against plain VRLs "
-           << "averaged over " << c.sets << " independent VRL sets of " << c.vrls << " VRLs (both estimate the true "
-           << "transport without bias): RMSE of their difference " << fmt(c.differenceRmse) << ", expected from "
+        md << "**Part (d) reference check** (" << s.scene.name << "): the part (d) reference (plain VRLs over "
+           << "independent VRL sets) against another method, stochastic VRL Lightcuts (K = 32) averaged over " << c.sets
+           << " renders of " << c.spp << " spp, each from its own set of " << c.vrls << " VRLs (both estimate the "
+           << "true transport without bias): RMSE of their difference " << fmt(c.differenceRmse) << ", expected from "
            << "their two noises " << fmt(c.expectedRmse) << " (ratio " << fmt(ratio) << "; "
            << (ratio < 1.5 ? "they agree within their noise" : "**they do not agree within their noise**")
-           << "). Cost of a noise (time × noise², lower is better): the stochastic reference "
+           << "). Cost of a noise (time × noise², lower is better): the reference "
            << fmt(s.partReference.seconds * s.partReference.noiseRmse * s.partReference.noiseRmse) << " ("
            << fmt(s.partReference.seconds) << " s, noise " << fmt(s.partReference.noiseRmse)
-           << (s.partReference.cached ? ", time as recorded in the cache" : "") << "), plain VRLs over sets "
-           << fmt(c.seconds * c.plainNoiseRmse * c.plainNoiseRmse) << " (" << fmt(c.seconds) << " s, noise "
-           << fmt(c.plainNoiseRmse) << ").\n\n";
+           << (s.partReference.cached ? ", time as recorded in the cache" : "") << "), stochastic VRL Lightcuts over "
+           << "sets " << fmt(c.seconds * c.checkNoiseRmse * c.checkNoiseRmse) << " (" << fmt(c.seconds)
+           << " s, noise " << fmt(c.checkNoiseRmse) << ").\n\n";
     }
     for (const auto& s : scenes) {
         if (!s.skipped.empty()) continue;
@@ -888,8 +904,8 @@ int runReport(const Options& o) {
                 referenceImage(s, *scene, ReferencePart::Multiple, referenceDir, log, report.partReference, left);
             if (o.buildReferences) return;
             if (scenes.empty())  // the first scene: the part (d) reference against plain VRLs over independent sets
-                report.partCheck = checkPartReference(s, *scene, partReference, report.partReference, 16,
-                                                      o.quick ? 3000 : 1000, log);
+                report.partCheck =
+                    checkPartReference(s, *scene, partReference, report.partReference, 16, 10000, 8, log);
             // The previews show the whole image, or part (d) where that is all a scene measures.
             const Image& shown = wholeImage ? reference : partReference;
             const float exposure = autoExposure(shown);
