@@ -42,10 +42,11 @@ for m in vrl vrl-lightcuts vrl-stochastic vpl-lightcuts; do
     grep -q "^bathroom,$m,.*,multiple$" "$out/results.csv" || fail "no part (d) $m row in results.csv"
 done
 grep -q "^bathroom,path,.*,multiple$" "$out/results.csv" && fail "the path tracer has no part (d) row"
-[ "$(awk -F, 'NR > 1 { print $18 ":" $16 }' "$out/results.csv" | sort -u | wc -l)" -eq 2 ] \
+[ "$(awk -F, 'NR > 1 && $1 == "bathroom" { print $18 ":" $16 }' "$out/results.csv" | sort -u | wc -l)" -eq 2 ] \
     || fail "the two parts should each have one reference noise"
 grep -q "Part (d) alone" "$out/summary.md" || fail "summary.md lacks the part (d) comparison"
-[ "$(grep -c '^\*\*Verdict for' "$out/summary.md")" -eq 2 ] || fail "summary.md should give a verdict per part"
+# bathroom: both parts; bathroom-hg07: part (d) alone.
+[ "$(grep -c '^\*\*Verdict for' "$out/summary.md")" -eq 3 ] || fail "summary.md should give a verdict per scene and part"
 # The part (d) reference agrees with plain VRLs over 16 independent sets: the RMSE of
 # their difference within 1.5x of what their noises predict (fixed seeds; measured 1.04).
 grep -q "they agree within their noise" "$out/summary.md" || fail "the part (d) reference check failed"
@@ -68,6 +69,20 @@ awk -F'|' '/^\| VRL Lightcuts point/ { table = 1; next }
 [ "$(grep -c '^bathroom,VRL-stochastic,' "$out/speedup.csv")" -eq 2 ] || fail "no stochastic speed-up rows"
 awk -F, 'NR > 1 && $2 == "VRL-stochastic" { if (!($5 > 0) || !($9 > 0)) { print "bad stochastic row: " $0; exit 1 } }' \
     "$out/speedup.csv" || fail "stochastic speed-up rows need a time and an error"
+# A scene measured on part (d) alone (bathroom-hg07): (d) rows only, no whole-image
+# reference built, its previews and Table 1 from the (d) runs.
+grep -q '^bathroom-hg07,.*,image$' "$out/results.csv" && fail "bathroom-hg07 has whole-image rows"
+for m in vrl vrl-lightcuts vrl-stochastic vpl-lightcuts; do
+    grep -q "^bathroom-hg07,$m,.*,multiple$" "$out/results.csv" || fail "no part (d) $m row for bathroom-hg07"
+done
+ls "$out/cache" | grep -qE '^bathroom-hg07-reference-[0-9a-f]{16}\.exr$' && fail "a whole-image reference for bathroom-hg07"
+ls "$out/cache" | grep -qE '^bathroom-hg07-reference-d-[0-9a-f]{16}\.exr$' || fail "no part (d) reference for bathroom-hg07"
+grep -q '^| bathroom-hg07 |.*| none (part (d) alone) |' "$out/summary.md" || fail "scenes table: bathroom-hg07"
+grep -q 'error-time-bathroom-hg07.png' "$out/summary.md" && fail "summary.md shows a whole-image plot for bathroom-hg07"
+for f in error-time-bathroom-hg07-d.png images/bathroom-hg07-reference.png images/bathroom-hg07-vrl-lightcuts-eval.png; do
+    [ -s "$out/$f" ] || fail "missing or empty $out/$f"
+done
+grep -E '^\| bathroom-hg07 \| 10000 \| [0-9]' "$out/summary.md" >/dev/null || fail "Table 1 row for bathroom-hg07"
 # "What to use when": a winner at some time budget, and where each winning method won.
 sed -n '/^## What to use when/,/^## Table 1/p' "$out/summary.md" | grep -qE '^\| bathroom \| whole image \|.*\*\*' \
     || fail "summary.md: no winner in 'What to use when'"
