@@ -864,7 +864,7 @@ int runReport(const Options& o) {
     const Log log(start);
     const int threads = o.threads > 0 ? o.threads : tbb::info::default_concurrency();
     tbb::task_arena arena(threads);
-    fs::create_directories(o.out / "images");
+    if (!o.buildReferences || o.quick) fs::create_directories(o.out / "images");  // --references writes only references
     std::vector<BenchmarkScene> list = benchmarkScenes(o.quick, VRL_SOURCE_DIR, o.shared);
     if (!o.only.empty()) {
         std::erase_if(list, [&](const BenchmarkScene& s) { return std::find(o.only.begin(), o.only.end(), s.name) == o.only.end(); });
