@@ -228,7 +228,7 @@ Image referenceImage(const BenchmarkScene& s, const Scene& scene, ReferencePart 
     info.method = image ? "path tracer, " + std::to_string(2 * perHalf) + " spp"
                         : "plain VRLs over " + std::to_string(sets) + " independent VRL sets of " +
                               std::to_string(first.vrlCount);
-    info.spp = 2 * perHalf;
+    info.spp = image ? 2 * perHalf : sets;  // camera samples per pixel in all (part (d): one per set)
     info.file = file;
     ImageSet set;
     if (fs::exists(file)) {
@@ -300,7 +300,7 @@ Image referenceImage(const BenchmarkScene& s, const Scene& scene, ReferencePart 
         record.defines = s.defines;
         record.medium = s.medium;
         record.settings = first;
-        record.settings.samplesPerPixel = 2 * perHalf;  // the chunks of the two halves together
+        record.settings.samplesPerPixel = info.spp;  // the chunks of the two halves together
         record.statistics.seconds = info.seconds;
         record.run = {{"halves", int32_t(2)}, {"chunks", int32_t(chunks)}};
         if (!image) record.run["vrlSets"] = int32_t(sets);
