@@ -522,6 +522,17 @@ const char* methodTitle(RenderMethod m) {
     return "?";
 }
 
+// The curves (MethodRun::curve()) a scene measured on one part, in run order.
+std::vector<std::string> curvesMeasured(const std::vector<RunResult>& results, const std::string& scene,
+                                        bool multipleOnly) {
+    std::vector<std::string> curves;
+    for (const auto& r : results)
+        if (r.scene == scene && r.run.multipleOnly == multipleOnly &&
+            std::find(curves.begin(), curves.end(), r.run.curve()) == curves.end())
+            curves.push_back(r.run.curve());
+    return curves;
+}
+
 // The points of one curve (MethodRun::curve()) above the noise rule's floor.
 std::vector<CurvePoint> curveOf(const std::vector<RunResult>& results, const std::string& scene,
                                 const std::string& curve, bool smape) {
@@ -618,9 +629,9 @@ void writeComparison(std::ostream& md, const std::vector<RunResult>& results, co
     std::vector<std::string> others = {"vrl", "vrl-stochastic K=8", "vrl-stochastic K=32", "vpl-lightcuts e=0.02"};
     if (!multipleOnly) others.push_back("path");
     for (auto& o : others) o = prefix + o;
+    const std::vector<std::string> measured = curvesMeasured(results, name, multipleOnly);
     std::erase_if(others, [&](const std::string& curve) {  // a curve this part does not measure
-        return std::none_of(results.begin(), results.end(),
-                            [&](const RunResult& r) { return r.scene == name && r.run.curve() == curve; });
+        return std::find(measured.begin(), measured.end(), curve) == measured.end();
     });
     const std::string recommended = prefix + "vrl-lightcuts e=0.02";
     md << "![error against time](error-time-" << safeName(name) << (multipleOnly ? "-d" : "") << ".png)\n\n";
@@ -685,11 +696,7 @@ void writeWhatToUseWhen(std::ostream& md, const std::vector<RunResult>& results,
     for (const auto& s : scenes) {
         if (!s.skipped.empty()) continue;
         for (const bool multipleOnly : {false, true}) {
-            std::vector<std::string> curves;
-            for (const auto& r : results)
-                if (r.scene == s.scene.name && r.run.multipleOnly == multipleOnly &&
-                    std::find(curves.begin(), curves.end(), r.run.curve()) == curves.end())
-                    curves.push_back(r.run.curve());
+            const std::vector<std::string> curves = curvesMeasured(results, s.scene.name, multipleOnly);
             if (curves.empty()) continue;
             const auto title = [&](const std::string& curve) {  // without the part's "(d) "
                 return curveTitle(multipleOnly ? curve.substr(4) : curve);
