@@ -607,7 +607,7 @@ std::string verdict(const std::vector<RunResult>& results, const std::string& na
         v << "VRL Lightcuts does **not** reach 10× less time than plain VRLs at equal error: at most "
           << fmt(*bestSpeedup) << "×. Per camera segment it evaluates #Eval = " << cost
           << " VRLs (plain VRLs evaluate all N)"
-          << (multipleOnly ? "" : "; parts (a)-(c) are path-sampled alike in both and cost both the same time")
+          << (multipleOnly ? "" : "; parts (a) and (b) are path-sampled alike in both and cost both the same time")
           << ". ";
     }
     if (vplMeasured == 0)
