@@ -5,12 +5,14 @@
 // one run are shared by all its pixels, so pixels are not independent); the
 // image mean and each 8x8 block mean must agree within 5 combined standard
 // errors of the K-run means (Student t with K-1 = 7 dof: P(|t| > 5) = 0.0016
-// per comparison, about 2% over the 15 comparisons of one scene).
+// per comparison, about 2% over the 15 comparisons of one scene). The sanitizer
+// build runs them on a quarter of the samples and lights (test_workload.h).
 #include "render/integrators/path_tracer.h"
 #include "render/integrators/transport_integrator.h"
 #include "render/renderer.h"
 #include "render/scene_io/mitsuba/mitsuba_parser.h"
 #include "tests/support/test_scenes.h"
+#include "tests/support/test_workload.h"
 
 #include <gtest/gtest.h>
 #include <tbb/parallel_for.h>
@@ -24,8 +26,10 @@ namespace {
 
 constexpr int kRuns = 8;
 constexpr int kBlock = 8;
-constexpr int kReferenceSpp = 2048;  // per pixel and run
-constexpr uint64_t kVrls = 6000;      // per run
+constexpr int kReferenceSpp = 2048 / test::kSanitizedWorkDivisor;  // per pixel and run
+constexpr uint64_t kVrls = 6000 / test::kSanitizedWorkDivisor;      // per run
+// Samples per pixel of the path-sampled parts (a)-(c) in the four-part runs.
+constexpr int kPartsSpp = 16 / test::kSanitizedWorkDivisor;
 
 // Block means (plus the whole-image mean last) of one image, per channel.
 std::vector<Rgb> blockMeans(const Image& image) {
@@ -84,7 +88,7 @@ void expectAgree(const RunStatistics& vrl, const RunStatistics& reference, const
     const size_t image = vrl.mean.size() - 1;
     std::printf("%s: image mean (green) vrl %.5f +- %.5f, reference %.5f +- %.5f\n", what, vrl.mean[image][1], vrl.standardError[image][1], reference.mean[image][1], reference.standardError[image][1]);
     EXPECT_GT(reference.mean[image][1], 0.0f);
-    EXPECT_LT(vrl.standardError[image][1], 0.05f * reference.mean[image][1]) << what << ": too noisy to mean much";
+    EXPECT_LT(vrl.standardError[image][1], 0.05f * test::kSanitizedNoiseFactor * reference.mean[image][1]) << what << ": too noisy to mean much";
 }
 
 RunStatistics referenceRuns(const Scene& scene, int spp, bool onlyMediumToMedium, int maxDepth = -1,
@@ -134,8 +138,8 @@ TEST(VrlImage, PartsSumToReferenceInMediumOnlyScene) {
     for (const MediumCase& m : kMedia) {
         const auto scene = Scene::build(test::mediumOnlyCube(m.sigmaS, m.sigmaA, m.g));
         const RunStatistics reference = referenceRuns(*scene, kReferenceSpp, false);
-        expectAgree(vrlRuns(*scene, "surface,single,medium-surface,multiple", 16, kVrls), reference, m.name);
-        expectAgree(vrlRuns(*scene, "surface,single,medium-surface,multiple", 16, kVrls, -1, RenderMethod::VrlStochastic),
+        expectAgree(vrlRuns(*scene, "surface,single,medium-surface,multiple", kPartsSpp, kVrls), reference, m.name);
+        expectAgree(vrlRuns(*scene, "surface,single,medium-surface,multiple", kPartsSpp, kVrls, -1, RenderMethod::VrlStochastic),
                     reference, (std::string(m.name) + " vrl-stochastic").c_str());
     }
 }
@@ -146,7 +150,7 @@ TEST(VrlImage, PartsSumToReferenceThroughGlassAndMirror) {
     const MediumCase& m = kMedia[0];
     const auto scene = Scene::build(test::glassAndMirrorRoom(m.sigmaS * 0.5f, m.sigmaA * 0.5f, m.g));
     ASSERT_TRUE(scene->hasSpecularSurfaces());
-    expectAgree(vrlRuns(*scene, "surface,single,medium-surface,multiple", 16, kVrls),
+    expectAgree(vrlRuns(*scene, "surface,single,medium-surface,multiple", kPartsSpp, kVrls),
                 referenceRuns(*scene, kReferenceSpp, false), "glass and mirror");
 }
 
@@ -158,7 +162,7 @@ TEST(VrlImage, PartsSumToReferenceInSharedVolCbox) {
     SceneDescription description = parseMitsubaScene(file);
     description.sensor.width = description.sensor.height = 16;
     const auto scene = Scene::build(description);
-    expectAgree(vrlRuns(*scene, "surface,single,medium-surface,multiple", 16, kVrls),
+    expectAgree(vrlRuns(*scene, "surface,single,medium-surface,multiple", kPartsSpp, kVrls),
                 referenceRuns(*scene, kReferenceSpp, false), "vol_cbox");
 }
 
@@ -191,7 +195,7 @@ TEST(VrlImage, MediumSurfaceEqualsRestrictedReferenceInSharedVolCbox) {
     expectAgree(vrlRuns(*scene, "medium-surface", 1, kVrls, -1, RenderMethod::VrlLightcuts), reference,
                 "vol_cbox (c) lightcuts");
     // The whole four-part image with both parts (c) and (d) by Lightcuts.
-    expectAgree(vrlRuns(*scene, "surface,single,medium-surface,multiple", 16, kVrls, -1, RenderMethod::VrlLightcuts),
+    expectAgree(vrlRuns(*scene, "surface,single,medium-surface,multiple", kPartsSpp, kVrls, -1, RenderMethod::VrlLightcuts),
                 referenceRuns(*scene, kReferenceSpp, false), "vol_cbox lightcuts");
 }
 
@@ -199,8 +203,8 @@ TEST(VrlImage, PartsSumToReferenceInLitRoomWithOccluder) {
     for (const MediumCase& m : kMedia) {
         const auto scene = Scene::build(test::litRoomWithOccluder(m.sigmaS * 0.5f, m.sigmaA * 0.5f, m.g));
         const RunStatistics reference = referenceRuns(*scene, kReferenceSpp, false);
-        expectAgree(vrlRuns(*scene, "surface,single,medium-surface,multiple", 16, kVrls), reference, m.name);
-        expectAgree(vrlRuns(*scene, "surface,single,medium-surface,multiple", 16, kVrls, -1, RenderMethod::VrlStochastic),
+        expectAgree(vrlRuns(*scene, "surface,single,medium-surface,multiple", kPartsSpp, kVrls), reference, m.name);
+        expectAgree(vrlRuns(*scene, "surface,single,medium-surface,multiple", kPartsSpp, kVrls, -1, RenderMethod::VrlStochastic),
                     reference, (std::string(m.name) + " vrl-stochastic").c_str());
     }
 }
@@ -218,7 +222,7 @@ TEST(VrlImage, PartsSumToReferenceWithDepthLimit) {
     const auto scene = Scene::build(test::litRoomWithOccluder(Rgb(0.4f), Rgb(0.1f), 0.0f));
     for (int depth : {2, 3, 4}) {
         const std::string what = "maxDepth " + std::to_string(depth);
-        expectAgree(vrlRuns(*scene, "surface,single,medium-surface,multiple", 16, kVrls, depth),
+        expectAgree(vrlRuns(*scene, "surface,single,medium-surface,multiple", kPartsSpp, kVrls, depth),
                     referenceRuns(*scene, kReferenceSpp / 2, false, depth), what.c_str());
     }
 }

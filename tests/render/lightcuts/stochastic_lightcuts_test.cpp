@@ -29,6 +29,7 @@
 #include "render/vrl/vrl_estimator.h"
 #include "render/vrl/vrl_surface_estimator.h"
 #include "tests/support/test_scenes.h"
+#include "tests/support/test_workload.h"
 
 #include <gtest/gtest.h>
 
@@ -276,7 +277,8 @@ TEST(StochasticLightcuts, EachQueryMatchesPlainVrlsInExpectation) {
 
 // --- The whole image: one VRL set, 64 camera seeds --------------------------
 
-constexpr int kSeeds = 64, kPlainSeeds = 8;
+// A quarter of the camera seeds in the sanitizer build (test_workload.h).
+constexpr int kSeeds = 64 / test::kSanitizedWorkDivisor, kPlainSeeds = 8;
 constexpr int kBlock = 8;
 
 std::vector<Rgb> blockMeans(const Image& image) {
@@ -322,7 +324,7 @@ void expectImagesAgree(const std::vector<MeanAndError>& a, const std::vector<Mea
     std::printf("%s: image mean (green) stochastic %.5f +- %.5f, plain %.5f +- %.5f\n", what.c_str(), image.mean.y,
                 image.standardError.y, b.back().mean.y, b.back().standardError.y);
     EXPECT_GT(b.back().mean.y, 0.0f) << what;
-    EXPECT_LT(image.standardError.y, 0.03f * b.back().mean.y) << what << ": too noisy to mean much";
+    EXPECT_LT(image.standardError.y, 0.03f * test::kSanitizedNoiseFactor * b.back().mean.y) << what << ": too noisy to mean much";
 }
 
 void expectStochasticMatchesPlain(const Scene& scene, const std::string& transports, const std::string& what) {
