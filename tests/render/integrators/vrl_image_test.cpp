@@ -30,6 +30,8 @@ constexpr int kReferenceSpp = 2048 / test::kSanitizedWorkDivisor;  // per pixel 
 constexpr uint64_t kVrls = 6000 / test::kSanitizedWorkDivisor;      // per run
 // Samples per pixel of the path-sampled parts (a)-(c) in the four-part runs.
 constexpr int kPartsSpp = 16 / test::kSanitizedWorkDivisor;
+// The four parts (a)+(b)+(c)+(d), the whole image.
+constexpr const char* kAllParts = "surface,single,medium-surface,multiple";
 
 // Block means (plus the whole-image mean last) of one image, per channel.
 std::vector<Rgb> blockMeans(const Image& image) {
@@ -138,8 +140,8 @@ TEST(VrlImage, PartsSumToReferenceInMediumOnlyScene) {
     for (const MediumCase& m : kMedia) {
         const auto scene = Scene::build(test::mediumOnlyCube(m.sigmaS, m.sigmaA, m.g));
         const RunStatistics reference = referenceRuns(*scene, kReferenceSpp, false);
-        expectAgree(vrlRuns(*scene, "surface,single,medium-surface,multiple", kPartsSpp, kVrls), reference, m.name);
-        expectAgree(vrlRuns(*scene, "surface,single,medium-surface,multiple", kPartsSpp, kVrls, -1, RenderMethod::VrlStochastic),
+        expectAgree(vrlRuns(*scene, kAllParts, kPartsSpp, kVrls), reference, m.name);
+        expectAgree(vrlRuns(*scene, kAllParts, kPartsSpp, kVrls, -1, RenderMethod::VrlStochastic),
                     reference, (std::string(m.name) + " vrl-stochastic").c_str());
     }
 }
@@ -150,7 +152,7 @@ TEST(VrlImage, PartsSumToReferenceThroughGlassAndMirror) {
     const MediumCase& m = kMedia[0];
     const auto scene = Scene::build(test::glassAndMirrorRoom(m.sigmaS * 0.5f, m.sigmaA * 0.5f, m.g));
     ASSERT_TRUE(scene->hasSpecularSurfaces());
-    expectAgree(vrlRuns(*scene, "surface,single,medium-surface,multiple", kPartsSpp, kVrls),
+    expectAgree(vrlRuns(*scene, kAllParts, kPartsSpp, kVrls),
                 referenceRuns(*scene, kReferenceSpp, false), "glass and mirror");
 }
 
@@ -162,7 +164,7 @@ TEST(VrlImage, PartsSumToReferenceInSharedVolCbox) {
     SceneDescription description = parseMitsubaScene(file);
     description.sensor.width = description.sensor.height = 16;
     const auto scene = Scene::build(description);
-    expectAgree(vrlRuns(*scene, "surface,single,medium-surface,multiple", kPartsSpp, kVrls),
+    expectAgree(vrlRuns(*scene, kAllParts, kPartsSpp, kVrls),
                 referenceRuns(*scene, kReferenceSpp, false), "vol_cbox");
 }
 
@@ -195,7 +197,7 @@ TEST(VrlImage, MediumSurfaceEqualsRestrictedReferenceInSharedVolCbox) {
     expectAgree(vrlRuns(*scene, "medium-surface", 1, kVrls, -1, RenderMethod::VrlLightcuts), reference,
                 "vol_cbox (c) lightcuts");
     // The whole four-part image with both parts (c) and (d) by Lightcuts.
-    expectAgree(vrlRuns(*scene, "surface,single,medium-surface,multiple", kPartsSpp, kVrls, -1, RenderMethod::VrlLightcuts),
+    expectAgree(vrlRuns(*scene, kAllParts, kPartsSpp, kVrls, -1, RenderMethod::VrlLightcuts),
                 referenceRuns(*scene, kReferenceSpp, false), "vol_cbox lightcuts");
 }
 
@@ -203,8 +205,8 @@ TEST(VrlImage, PartsSumToReferenceInLitRoomWithOccluder) {
     for (const MediumCase& m : kMedia) {
         const auto scene = Scene::build(test::litRoomWithOccluder(m.sigmaS * 0.5f, m.sigmaA * 0.5f, m.g));
         const RunStatistics reference = referenceRuns(*scene, kReferenceSpp, false);
-        expectAgree(vrlRuns(*scene, "surface,single,medium-surface,multiple", kPartsSpp, kVrls), reference, m.name);
-        expectAgree(vrlRuns(*scene, "surface,single,medium-surface,multiple", kPartsSpp, kVrls, -1, RenderMethod::VrlStochastic),
+        expectAgree(vrlRuns(*scene, kAllParts, kPartsSpp, kVrls), reference, m.name);
+        expectAgree(vrlRuns(*scene, kAllParts, kPartsSpp, kVrls, -1, RenderMethod::VrlStochastic),
                     reference, (std::string(m.name) + " vrl-stochastic").c_str());
     }
 }
@@ -222,7 +224,7 @@ TEST(VrlImage, PartsSumToReferenceWithDepthLimit) {
     const auto scene = Scene::build(test::litRoomWithOccluder(Rgb(0.4f), Rgb(0.1f), 0.0f));
     for (int depth : {2, 3, 4}) {
         const std::string what = "maxDepth " + std::to_string(depth);
-        expectAgree(vrlRuns(*scene, "surface,single,medium-surface,multiple", kPartsSpp, kVrls, depth),
+        expectAgree(vrlRuns(*scene, kAllParts, kPartsSpp, kVrls, depth),
                     referenceRuns(*scene, kReferenceSpp / 2, false, depth), what.c_str());
     }
 }
