@@ -610,7 +610,13 @@ std::string verdict(const std::vector<RunResult>& results, const std::string& na
           << (multipleOnly ? "" : "; parts (a) and (b) are path-sampled alike in both and cost both the same time")
           << ". ";
     }
-    if (vplMeasured == 0)
+    const bool vplRun = std::any_of(results.begin(), results.end(), [&](const RunResult& r) {
+        return r.scene == name && r.run.curve() == prefix + "vpl-lightcuts e=0.02";
+    });
+    if (!vplRun)
+        v << "VPL Lightcuts was not run on this part of this scene (the report's time limit; see the settings above "
+             "the tables), so there is no comparison with it here.";
+    else if (vplMeasured == 0)
         v << "Against VPL Lightcuts at equal time: not measurable (the curves do not overlap in time).";
     else if (vplBeaten == vplMeasured)
         v << "It has lower error than VPL Lightcuts at equal time at every overlapping point (VPL's error × " << vplRatios
@@ -647,6 +653,24 @@ void writeComparison(std::ostream& md, const std::vector<RunResult>& results, co
            << (cuts ? fmt(r.stats.meanEvaluated, 4) : "") << " | " << (cuts ? fmt(r.stats.meanIntersected, 4) : "")
            << " |\n";
     }
+    // The noise rule, said in words where it decides the comparison: a reference too
+    // noisy for every run is a failed reference, not a result about the methods.
+    int runs = 0, below = 0;
+    double floor = 0.0;
+    for (const auto& r : results) {
+        if (r.scene != name || r.run.multipleOnly != multipleOnly) continue;
+        ++runs;
+        below += r.belowNoise();
+        floor = kNoiseFactor * r.referenceNoiseRmse;
+    }
+    if (runs > 0 && below == runs)
+        md << "\n**This comparison cannot decide:** every run's RMSE is below the noise rule's floor (" << fmt(floor)
+           << ", " << fmt(kNoiseFactor) << "× the reference's own noise), so the reference fails the rule at this "
+           << "resolution and no curve, ratio or verdict below says anything about the methods. It needs a better "
+           << "reference, not more of these runs.\n";
+    else if (below > 0)
+        md << "\n" << below << " of " << runs << " runs are below the noise rule's floor (" << fmt(floor)
+           << ") and are left out of the ratios.\n";
     md << "\nEqual-time error ratios (the other method's error at VRL Lightcuts' time, divided by VRL Lightcuts' "
           "error; > 1: VRL Lightcuts is better) and equal-error time ratios (the other method's time to reach VRL "
           "Lightcuts' RMSE, divided by VRL Lightcuts' time; > 1: VRL Lightcuts is faster); '—' where the other "
