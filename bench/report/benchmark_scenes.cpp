@@ -144,10 +144,10 @@ std::vector<BenchmarkScene> benchmarkScenes(bool quick, const std::filesystem::p
         // --quick has it too, so that a scene measured on part (d) alone is tested.
         BenchmarkScene hg = own("bathroom-hg07", "the same with Henyey-Greenstein g = 0.7 (forward scattering)",
                                 {{"g", "0.7"}});
-        // The full report's 45-minute limit: here VRL Lightcuts cost 70-86 s a run at
-        // N >= 10k (the HG bound refines more) and VPL Lightcuts 58-124 s, so this scene
-        // keeps plain VRLs, VRL Lightcuts at the default e = 0.02 up to 10k, and the
-        // stochastic cuts (measured at 62 min with everything; 10 of them on this scene).
+        // The full report's 45-minute limit (62 min with every run): here VRL Lightcuts
+        // cost 70-86 s a run at N >= 10k (the HG bound refines more) and VPL Lightcuts
+        // 58-124 s, 10 min for this scene. It keeps plain VRLs, VRL Lightcuts at the
+        // default e = 0.02 up to N = 10k and the stochastic cuts.
         std::erase_if(hg.runs, [&](const MethodRun& r) {
             if (!r.multipleOnly) return true;
             if (quick) return false;

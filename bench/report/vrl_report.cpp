@@ -614,8 +614,8 @@ std::string verdict(const std::vector<RunResult>& results, const std::string& na
         return r.scene == name && r.run.curve() == prefix + "vpl-lightcuts e=0.02";
     });
     if (!vplRun)
-        v << "VPL Lightcuts was not run on this part of this scene (the report's time limit; see the settings above "
-             "the tables), so there is no comparison with it here.";
+        v << "VPL Lightcuts was not run on this part of this scene (left out to keep the full report within its "
+             "45-minute limit), so there is no comparison with it here.";
     else if (vplMeasured == 0)
         v << "Against VPL Lightcuts at equal time: not measurable (the curves do not overlap in time).";
     else if (vplBeaten == vplMeasured)
