@@ -39,6 +39,12 @@ struct BenchmarkScene {
     int width = 64, height = 48;
     int maxDepth = 12;              // the paper's "maximum path length is 12 for all the scenes"
     int referenceSpp = 256;         // path tracer; two independent halves of referenceSpp / 2
+    // > 0: the whole image's reference is light tracing connected to the camera
+    // (render/integrators/light_tracing_reference.h), this many light paths in all,
+    // plus referenceSpp camera samples per pixel for what light tracing cannot
+    // connect (the camera seeing glass, mirrors or emitters). For scenes lit
+    // through specular surfaces, where the path tracer's reference is fireflies.
+    uint64_t referenceLightPaths = 0;
     // Part (d)'s reference: plain VRLs (1 spp) over independent VRL sets, so that it
     // converges to the true transport; partReferenceSets sets of partReferenceVrls
     // VRLs in each of its 8 chunks of each half (measured on bathroom at 320x180:

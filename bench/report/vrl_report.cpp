@@ -1,7 +1,8 @@
 // vrl_report: error against run time for every method on the benchmark scenes
 // (Vibert et al. 2019, Figures 3, 4, 6 and Table 1). For each scene: two
-// references, the whole image (path tracer) and part (d) alone (plain VRLs over
-// independent VRL sets), each two independent halves whose
+// references, the whole image (path tracer; light tracing connected to the
+// camera where the light arrives through glass) and part (d) alone (plain VRLs
+// over independent VRL sets), each two independent halves whose
 // difference estimates its noise, rendered in resumable chunks and kept in
 // bench/references by a hash of the scene's files, the settings and the method;
 // then every method over a range of settings, for the whole image and for part
@@ -19,6 +20,7 @@
 #include "render/image/exr_io.h"
 #include "render/image/image_metrics.h"
 #include "render/image/preview_image.h"
+#include "render/integrators/light_tracing_reference.h"
 #include "render/render_metadata.h"
 #include "render/renderer.h"
 #include "render/scene/scene.h"
@@ -98,7 +100,8 @@ double relativeRmse(const std::vector<float>& test, const std::vector<float>& re
     return compareImages(row(reference), row(test)).relativeRmse;
 }
 
-// The two references of a scene: the whole image (path tracer) and part (d) alone
+// The two references of a scene: the whole image (path tracer, or light tracing
+// connected to the camera: BenchmarkScene::referenceLightPaths) and part (d) alone
 // (plain VRLs over many independent VRL sets).
 enum class ReferencePart { Image, Multiple };
 
@@ -193,6 +196,40 @@ std::vector<RenderSettings> referenceChunk(const BenchmarkScene& s, ReferencePar
     return sets;
 }
 
+constexpr float kReferencePixelFootprint = 0.25f;
+
+// A whole-image reference by light tracing connected to the camera (BenchmarkScene::referenceLightPaths).
+bool lightTracedReference(const BenchmarkScene& s, ReferencePart part) {
+    return part == ReferencePart::Image && s.referenceLightPaths > 0;
+}
+
+// Chunk `chunk` of one half of a reference: the mean of referenceChunk's renders,
+// or one light-tracing render from its own seed.
+Image renderReferenceChunk(const BenchmarkScene& s, const Scene& scene, ReferencePart part, uint64_t half, int chunk) {
+    if (lightTracedReference(s, part)) {
+        LightTracingReferenceSettings settings;
+        settings.lightPaths = std::max<uint64_t>(1, s.referenceLightPaths / 2 / kReferenceChunks);
+        settings.samplesPerPixel = std::max(1, s.referenceSpp / 2 / kReferenceChunks);
+        settings.seed = 3000003 + 2 * uint64_t(chunk) + half;
+        settings.maxDepth = s.maxDepth;
+        // As the runs' rays (settingsFor: RenderSettings::jitter is false): part 2 at pixel centres,
+        // part 1 over the centred quarter of each pixel's width. Measured on volumetric-caustic
+        // (part 1, luminance): whole pixels against that quarter differ by RMSE 0.17 (the light's
+        // glow falls off within a pixel), the quarter against a sixteenth by none that 32M light
+        // paths could resolve (below 0.02); the quarter's noise is 4x the whole pixel's.
+        settings.pixelCentres = true;
+        settings.pixelFootprint = kReferencePixelFootprint;
+        return renderLightTracingReference(scene, settings);
+    }
+    const std::vector<RenderSettings> renders = referenceChunk(s, part, half, chunk);
+    Image mean(s.width, s.height);
+    for (const RenderSettings& settings : renders) {
+        const Image one = render(scene, settings).image;
+        for (size_t i = 0; i < one.pixelCount(); ++i) mean[i] = mean[i] + one[i] * (1.0f / float(renders.size()));
+    }
+    return mean;
+}
+
 std::string gitCommit() {
     const std::string command = "git -C '" + std::string(VRL_SOURCE_DIR) + "' rev-parse --short HEAD 2>/dev/null";
     std::string out;
@@ -217,15 +254,24 @@ Image referenceImage(const BenchmarkScene& s, const Scene& scene, ReferencePart 
     const int chunks = kReferenceChunks;
     const int perHalf = chunks * first.samplesPerPixel;
     const int sets = 2 * chunks * s.partReferenceSets;  // part (d): VRL sets in all
+    const bool lightTraced = lightTracedReference(s, part);
+    const uint64_t lightPaths = uint64_t(2 * chunks) * std::max<uint64_t>(1, s.referenceLightPaths / 2 / kReferenceChunks);
     std::string key = image ? "path spp=" + std::to_string(first.samplesPerPixel) + "x" + std::to_string(chunks) + "x2"
                             : "vrl transports=multiple vrls=" + std::to_string(first.vrlCount) + " spp=1 sets=" +
                                   std::to_string(s.partReferenceSets) + "x" + std::to_string(chunks) + "x2";
+    if (lightTraced)
+        key = "light tracing to the camera paths=" + std::to_string(lightPaths) + " footprint=" +
+              std::to_string(kReferencePixelFootprint) + " path tracer at pixel centres " + key;
     key += " maxDepth=" + std::to_string(s.maxDepth) + " size=" + std::to_string(s.width) + "x" +
            std::to_string(s.height) + " medium=" + s.medium + " version=" + VRL_VERSION;
     const fs::path file =
         dir / (s.name + (image ? "-reference-" : "-reference-d-") + hashSceneAndSettings(s, key) + ".exr");
     info.part = part;
-    info.method = image ? "path tracer, " + std::to_string(2 * perHalf) + " spp"
+    info.method = lightTraced ? "light tracing to the camera, " + std::to_string(lightPaths / 1000000) +
+                                    "M light paths over the centred quarter of each pixel's width, plus the path "
+                                    "tracer where the camera sees specular surfaces or "
+                                    "emitters, " + std::to_string(2 * perHalf) + " spp at pixel centres"
+                : image ? "path tracer, " + std::to_string(2 * perHalf) + " spp"
                         : "plain VRLs over " + std::to_string(sets) + " independent VRL sets of " +
                               std::to_string(first.vrlCount);
     info.spp = image ? 2 * perHalf : sets;  // camera samples per pixel in all (part (d): one per set)
@@ -257,12 +303,7 @@ Image referenceImage(const BenchmarkScene& s, const Scene& scene, ReferencePart 
         const auto start = Clock::now();
         while (done < chunks) {
             for (uint64_t h = 0; h < 2; ++h) {
-                const std::vector<RenderSettings> renders = referenceChunk(s, part, h, done);
-                Image chunk(s.width, s.height);
-                for (const RenderSettings& settings : renders) {
-                    const Image one = render(scene, settings).image;
-                    for (size_t i = 0; i < one.pixelCount(); ++i) chunk[i] = chunk[i] + one[i] * (1.0f / float(renders.size()));
-                }
+                const Image chunk = renderReferenceChunk(s, scene, part, h, done);
                 for (size_t i = 0; i < chunk.pixelCount(); ++i)  // the running mean of the chunks
                     halves[h][i] = halves[h][i] + (chunk[i] - halves[h][i]) * (1.0f / float(done + 1));
             }
@@ -304,6 +345,10 @@ Image referenceImage(const BenchmarkScene& s, const Scene& scene, ReferencePart 
         record.statistics.seconds = info.seconds;
         record.run = {{"halves", int32_t(2)}, {"chunks", int32_t(chunks)}};
         if (!image) record.run["vrlSets"] = int32_t(sets);
+        if (lightTraced) {
+            record.run["lightPaths"] = double(lightPaths);
+            record.run["estimator"] = std::string("light tracing to the camera");
+        }
         writeRenderMetadata(record, scene.camera(), set.metadata);
         set.metadata["vrl.report.key"] = key;
         set.metadata["vrl.report.seconds"] = info.seconds;
@@ -789,7 +834,9 @@ void writeSummary(const fs::path& path, const Options& o, const std::vector<Scen
     md << "Generated by `build/bench/vrl_report" << (o.quick ? " --quick" : "") << "` on " << date << " with " << threads
        << " threads, vrlcuts " << VRL_VERSION << "; the whole report took " << fmt(totalSeconds / 60.0, 3)
        << " minutes. Data: `results.csv`, `speedup.csv`.\n\n";
-    md << "Every image is compared with its reference: the whole image with the path tracer's, part (d) alone with "
+    md << "Every image is compared with its reference: the whole image with the path tracer's (on a scene lit "
+          "through glass, light tracing connected to the camera plus the path tracer where the camera sees the "
+          "glass: the scene table says which), part (d) alone with "
           "plain VRLs averaged over many independent VRL sets (each reference two independent halves; the noise "
           "columns are its own estimated error, RMSE(half1, half2) / 2, below which no method can be measured). "
           "Times are wall-clock seconds of light tracing, tree build and shading; the scene load is common to all "
@@ -813,7 +860,7 @@ void writeSummary(const fs::path& path, const Options& o, const std::vector<Scen
         md << "| " << s.scene.name << " | " << s.scene.description << (s.scene.medium.empty() ? "" : " (`--medium " + s.scene.medium + "`)")
            << " | " << s.scene.width << "x" << s.scene.height << " | ";
         if (s.reference.spp > 0)
-            md << s.reference.spp << " spp, " << fmt(s.reference.seconds, 4) << " s"
+            md << s.reference.method << ", " << fmt(s.reference.seconds, 4) << " s"
                << (s.reference.cached ? " (cached)" : "") << " | " << fmt(s.reference.noiseRmse) << " / "
                << fmt(s.reference.noiseRelativeRmse) << " / " << fmt(s.reference.noiseSmape) << " | ";
         else
@@ -1095,8 +1142,9 @@ int main(int argc, char** argv) {
     app.add_flag("--quick", o.quick, "A small version (our own scene at 32x24, and its g = 0.7 variant on part "
                                      "(d) alone; short sweeps): under 3 minutes; its references go to OUT/cache");
     app.add_flag("--references", o.buildReferences,
-                 "Only build the references that are missing (the whole image by the path tracer, part (d) by "
-                 "plain VRLs over independent VRL sets; hours), then stop");
+                 "Only build the references that are missing (the whole image by the path tracer, or by light "
+                 "tracing to the camera where a scene says so; part (d) by plain VRLs over independent VRL sets; "
+                 "hours), then stop");
     app.add_option("--reference-minutes", o.referenceMinutes,
                    "--references: stop each scene's references after about this many minutes, at least one chunk "
                    "each (0, the default: no limit); the chunks done are kept and a later run resumes them")

@@ -131,6 +131,7 @@ Rgb VolumetricPathTracer::radiance(Ray ray, int medium, Rng& rng, const PathStar
         const bool atX1 = !specularChain && !pastX1;
         if (!specularChain) firstSegment = false, pastX1 = true;
         const bool onlyInMediumNext = atX1 && start.afterFirstSurface == After::InMedium;
+        const bool onlyDiracNext = atX1 && start.diracAtFirstSurfaceOnly;
         if (Scene::withinCrossing(ray, *hit)) medium = mediumBeforeCrossing;
         if (restricted && vertices + 1 <= 2) break;  // a surface among the first two vertices
 
@@ -138,7 +139,7 @@ Rgb VolumetricPathTracer::radiance(Ray ray, int medium, Rng& rng, const PathStar
         if (!mayScatterAgain()) break;
         const ShadingPoint sp = hit->shadingPoint();
         const Vec3 wo = -ray.direction;
-        if (!bsdf.isPurelySpecular() && !onlyInMediumNext) {
+        if (!bsdf.isPurelySpecular() && !onlyInMediumNext && !onlyDiracNext) {
             const DirectLighting direct = sampleDirectLighting(scene_, hit->position, &*hit, medium, rng);
             if (counts() && !isBlack(direct.radianceOverPdf)) {
                 const Rgb f = bsdf.eval(sp, wo, direct.direction, TransportMode::Radiance);
@@ -157,6 +158,7 @@ Rgb VolumetricPathTracer::radiance(Ray ray, int medium, Rng& rng, const PathStar
         if (!sampled || isBlack(sampled->weight)) break;
         if (atX1 && !sampled->delta) afterX1 = start.afterFirstSurface;
         if (onlyInMediumNext && sampled->delta) break;
+        if (onlyDiracNext && !sampled->delta) break;
         throughput *= sampled->weight;
         const bool misEmission = settings_.surfaceMis && !sampled->delta;
         emissionCounts = (sampled->delta || misEmission) && (!restricted || vertices >= 2) && afterX1 != After::InMedium;

@@ -64,6 +64,11 @@ struct PathStart {
     //     unscattered ends the path (the reference for part (c) alone).
     enum class AfterFirstSurface { Any, NotInMedium, InMedium };
     AfterFirstSurface afterFirstSurface = AfterFirstSurface::Any;
+    // Only paths that leave x1 by a Dirac lobe (glass, mirrors, a plastic's coating)
+    // count from x1 on: no NEE at x1, a non-Dirac sample there ends the path. With
+    // firstSegmentTransmittanceOnly and emissionOnFirstHit, the complement of light
+    // tracing connected to the camera (light_tracing_reference.h).
+    bool diracAtFirstSurfaceOnly = false;
 };
 
 class VolumetricPathTracer {

@@ -1,5 +1,6 @@
 #include "render/scene/camera.h"
 
+#include <algorithm>
 #include <array>
 
 #include <cmath>
@@ -8,6 +9,7 @@ namespace vrl {
 
 PerspectiveCamera::PerspectiveCamera(const SensorDescription& sensor)
     : worldFromCamera_(sensor.toWorld),
+      cameraFromWorld_(sensor.toWorld.inverse()),
       position_(sensor.toWorld.applyPoint(Vec3(0.0f))),
       width_(sensor.width),
       height_(sensor.height),
@@ -36,6 +38,28 @@ Ray PerspectiveCamera::generateRay(float filmX, float filmY) const {
     const float localLength = local.length();  // z = 1: the clip distances scale by this
     Ray ray{position_ + dir * (nearClip_ * localLength), dir, (farClip_ - nearClip_) * localLength};
     return ray;
+}
+
+std::optional<PerspectiveCamera::Projection> PerspectiveCamera::project(const Vec3& p) const {
+    const Vec3 local = cameraFromWorld_.applyPoint(p);
+    if (!(local.z > nearClip_ && local.z < farClip_)) return std::nullopt;
+    // generateRay's inverse: local direction (-ndcX tanHalfX, -ndcY tanHalfY, 1).
+    const float filmX = (1.0f - local.x / (local.z * tanHalfX_)) * 0.5f * float(width_);
+    const float filmY = (1.0f - local.y / (local.z * tanHalfY_)) * 0.5f * float(height_);
+    const float imageX = filmX - float(cropX0()), imageY = filmY - float(cropY0());
+    if (!(imageX >= 0.0f && imageX < float(width()) && imageY >= 0.0f && imageY < float(height()))) return std::nullopt;
+    Projection out;
+    out.x = std::min(int(imageX), width() - 1);
+    out.y = std::min(int(imageY), height() - 1);
+    out.offsetX = imageX - float(out.x) - 0.5f;
+    out.offsetY = imageY - float(out.y) - 0.5f;
+    const Vec3 toP = p - position_;
+    out.distance = toP.length();
+    const float cosTheta = local.z / local.length();
+    out.rayOrigin = position_ + toP * (nearClip_ / local.z);  // at camera depth nearClip, as generateRay's
+    const float pixelArea = (2.0f * tanHalfX_ / float(width_)) * (2.0f * tanHalfY_ / float(height_));
+    out.importance = 1.0f / (pixelArea * cosTheta * cosTheta * cosTheta);
+    return out;
 }
 
 Imath::M44f PerspectiveCamera::worldToCamera() const {

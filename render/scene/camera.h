@@ -40,6 +40,27 @@ public:
     // Primary ray through film position (filmX, filmY) in pixels (of the film, not the crop).
     Ray generateRay(float filmX, float filmY) const;
 
+    // Where the pinhole sees world point p, for estimators that connect light-path
+    // vertices to the camera: the image pixel it lands in, the start of the camera
+    // ray towards it (on the near clip plane, where generateRay's rays start) and
+    // the pinhole's importance for that direction. None when p is off the image
+    // (or its crop window) or outside the clip range.
+    //
+    // The importance: a pixel's value is the mean radiance over its area A on the
+    // plane at unit distance in front of the pinhole (a box filter over the pixel,
+    // as jittered rays average), and dA = dw / cos^3(theta), theta the angle to the
+    // viewing axis. A point source of intensity I at distance d then adds
+    // I / (d^2 A cos^3 theta) to its pixel: `importance` is 1 / (A cos^3 theta).
+    // (Rigid or uniformly scaled sensor transforms; Mitsuba's look-at ones are.)
+    struct Projection {
+        int x = 0, y = 0;  // image pixel (of the crop window when there is one)
+        float offsetX = 0.0f, offsetY = 0.0f;  // where in that pixel, from its centre, in [-0.5, 0.5)
+        Vec3 rayOrigin;    // where the camera ray towards p starts
+        float distance = 0.0f;  // from the pinhole to p
+        float importance = 0.0f;
+    };
+    std::optional<Projection> project(const Vec3& p) const;
+
     // OpenEXR's standard attributes, for row vectors (p' = p M, Imath's
     // convention). worldToCamera: into a left-handed camera space with +x to
     // the image's right, +y up and +z the viewing direction (Mitsuba's camera
@@ -52,6 +73,7 @@ public:
 
 private:
     Transform worldFromCamera_;
+    Transform cameraFromWorld_;
     Vec3 position_;
     int width_, height_;  // the film
     std::optional<FilmCrop> crop_;

@@ -46,4 +46,47 @@ struct LightTracingSettings {
 VrlSet traceVrls(const Scene& scene, const LightTracingSettings& settings,
                  const std::function<void(double fraction)>& progress = {});
 
+// A scattering vertex of a light path, for estimators that connect light paths
+// to the camera (light_tracing_reference.h). Its weight: in a medium, the
+// throughput arriving times sigma_s over the density the collision was sampled
+// with (what the VPL of a real collision carries), so that the mean over paths
+// of the sum of weight x g(v, direction) over their medium vertices is the
+// integral over the volume and directions of sigma_s x incident radiance x g;
+// on a surface, the throughput arriving (the BSDF is not applied yet).
+struct LightPathVertex {
+    Vec3 position;
+    Vec3 direction;  // the direction the path travels in as it arrives
+    Rgb weight{0.0f};
+    int medium = -1;                      // the medium the path arrives through
+    const SurfaceHit* surface = nullptr;  // null for a medium vertex
+    // Scattering vertices on the path up to this one, itself included: connected
+    // to the camera, it makes a camera path of depth + 1 segments.
+    int depth = 0;
+};
+
+// Walks the light paths of `settings` one at a time: path `index` uses the same
+// random stream and the same emitter, collision, phase and BSDF sampling as
+// traceVrls' path `index`, with weights not divided by the path count.
+// Thread-safe (const); build one per render, not per path.
+class LightPathWalker {
+public:
+    LightPathWalker(const Scene& scene, const LightTracingSettings& settings);
+
+    // Calls `visit` at each vertex of path `index` where it scatters in a medium or
+    // meets a surface that is not purely specular, up to the vertices whose camera
+    // connection stays within settings.maxDepth (depth + 1 <= maxDepth). Deposits nothing.
+    void walk(uint64_t index, const std::function<void(const LightPathVertex&)>& visit) const {
+        trace(index, nullptr, &visit);
+    }
+    // Appends the VRLs (or VPLs) of path `index` to `out`, flux not yet divided by the path count.
+    void deposit(uint64_t index, std::vector<Vrl>& out) const { trace(index, &out, nullptr); }
+
+private:
+    void trace(uint64_t index, std::vector<Vrl>* out, const std::function<void(const LightPathVertex&)>* visit) const;
+
+    const Scene& scene_;
+    LightTracingSettings settings_;
+    std::vector<char> areaEmitter_;  // by emitter index: emits from a surface
+};
+
 }  // namespace vrl

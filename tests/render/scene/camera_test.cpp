@@ -184,5 +184,71 @@ TEST(CameraTest, CropWindowKeepsFilmPixelsAndItsNdcSpansTheWindow) {
     }
 }
 
+// project() inverts generateRay: a point on the ray through film position (fx, fy)
+// lands in the pixel holding (fx, fy) (of the crop window), its camera ray starts
+// where generateRay's does, and points off the image, behind the camera or before
+// the near clip plane are not seen.
+TEST(CameraTest, ProjectFindsThePixelAndTheRayOfAPoint) {
+    for (const bool cropped : {false, true}) {
+        SensorDescription sensor = tiltedSensor(64, 48, 53.0f, FovAxis::X);
+        sensor.nearClip = 0.5f;
+        if (cropped) sensor.crop = FilmCrop{10, 6, 20, 12};
+        const PerspectiveCamera camera(sensor);
+        for (const auto& [fx, fy] : {std::pair{10.5f, 6.25f}, std::pair{29.9f, 17.1f}, std::pair{17.5f, 9.75f}}) {
+            const Ray ray = camera.generateRay(fx, fy);
+            const Vec3 point = ray.origin + ray.direction * 7.0f;
+            const auto seen = camera.project(point);
+            ASSERT_TRUE(seen) << fx << ", " << fy;
+            EXPECT_EQ(seen->x, int(fx) - camera.cropX0());
+            EXPECT_EQ(seen->y, int(fy) - camera.cropY0());
+            EXPECT_LT((seen->rayOrigin - ray.origin).length(), 1e-4f);
+            EXPECT_NEAR(seen->distance, (point - camera.position()).length(), 1e-4f);
+            EXPECT_FALSE(camera.project(camera.position() - (point - camera.position())));  // behind
+            EXPECT_FALSE(camera.project(camera.position() + ray.direction * 0.3f));  // before the near clip plane
+        }
+        const Ray off = camera.generateRay(cropped ? 5.0f : -0.5f, 20.0f);  // left of the crop window, or of the film
+        EXPECT_FALSE(camera.project(off.origin + off.direction * 3.0f));
+    }
+}
+
+// The importance is the pinhole's We for a box filter over the pixel: integrated
+// over the pixel's solid angle it is exactly 1. Solid angles here come from
+// generateRay's directions alone (16 x 16 spherical quads per pixel, each two
+// triangles by Van Oosterom and Strackee's formula), not from the film-plane
+// geometry project() uses; a corner pixel of a wide camera (fov 100 along x, so
+// cos^3 varies across it) and a centre pixel. Tolerance 1e-4: the quadrature's own
+// error there is ~1e-6.
+TEST(CameraTest, ImportanceIntegratesToOneOverEachPixel) {
+    SensorDescription sensor = tiltedSensor(16, 12, 100.0f, FovAxis::X);
+    const PerspectiveCamera camera(sensor);
+    const auto direction = [&](double fx, double fy) {
+        const Vec3 d = camera.generateRay(float(fx), float(fy)).direction;
+        return Imath::V3d(d.x, d.y, d.z);
+    };
+    const auto triangle = [](const Imath::V3d& a, const Imath::V3d& b, const Imath::V3d& c) {
+        const double numerator = std::abs(a.dot(b.cross(c)));
+        const double denominator = 1.0 + a.dot(b) + b.dot(c) + c.dot(a);
+        return 2.0 * std::atan2(numerator, denominator);
+    };
+    for (const auto& [px, py] : {std::pair{0, 0}, std::pair{8, 6}, std::pair{15, 11}}) {
+        constexpr int n = 16;
+        double integral = 0.0;
+        for (int i = 0; i < n; ++i)
+            for (int j = 0; j < n; ++j) {
+                const double x0 = px + double(i) / n, x1 = px + double(i + 1) / n;
+                const double y0 = py + double(j) / n, y1 = py + double(j + 1) / n;
+                const Imath::V3d a = direction(x0, y0), b = direction(x1, y0), c = direction(x1, y1), d = direction(x0, y1);
+                const double solidAngle = triangle(a, b, c) + triangle(a, c, d);
+                const Vec3 centre = camera.generateRay(float(0.5 * (x0 + x1)), float(0.5 * (y0 + y1))).direction;
+                const auto seen = camera.project(camera.position() + centre * 10.0f);
+                ASSERT_TRUE(seen);
+                EXPECT_EQ(seen->x, px);
+                EXPECT_EQ(seen->y, py);
+                integral += double(seen->importance) * solidAngle;
+            }
+        EXPECT_NEAR(integral, 1.0, 1e-4) << "pixel " << px << ", " << py;
+    }
+}
+
 }  // namespace
 }  // namespace vrl

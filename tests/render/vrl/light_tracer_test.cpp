@@ -138,5 +138,52 @@ TEST(LightTracer, MaxDepthBelowThreeDepositsNothing) {
     for (const Vrl& v : set.vrls) ASSERT_LT(v.origin.length(), 1e-3f);
 }
 
+// LightPathWalker::walk follows the very paths deposit() turns into VRLs: in a grey
+// medium (no null collisions) each medium vertex of path i is where one of its VRLs
+// ends and the next begins, numbered 1, 2, ... along the path, with the flux of
+// the VRL that ends there times sigma_s / sigma_t; and walk stops at the vertices
+// whose camera connection would exceed maxDepth (depth + 1 <= maxDepth).
+TEST(LightTracer, WalkVisitsTheVerticesBetweenThePathsVrls) {
+    const Rgb sigmaS(0.5f), sigmaA(0.1f);
+    const auto scene = Scene::build(test::pointLightInInfiniteMedium(Rgb(1.0f), Vec3(0.0f), sigmaS, sigmaA, 0.3f));
+    for (const int maxDepth : {-1, 4}) {
+        LightTracingSettings settings;
+        settings.seed = 9;
+        settings.maxDepth = maxDepth;
+        const LightPathWalker walker(*scene, settings);
+        size_t visited = 0;
+        for (uint64_t i = 0; i < 200; ++i) {
+            std::vector<Vrl> vrls;
+            walker.deposit(i, vrls);
+            std::vector<LightPathVertex> vertices;
+            walker.walk(i, [&](const LightPathVertex& v) { vertices.push_back(v); });
+            visited += vertices.size();
+            for (size_t j = 0; j < vertices.size(); ++j) {
+                const LightPathVertex& v = vertices[j];
+                EXPECT_EQ(v.depth, int(j) + 1);
+                EXPECT_EQ(v.surface, nullptr);
+                if (maxDepth > 0) {
+                    EXPECT_LE(v.depth + 1, maxDepth);
+                }
+                // VRL j ends at vertex j (VRLs stop at maxDepth - 2 segments, vertices go one further).
+                if (j >= vrls.size()) continue;
+                const Vrl& before = vrls[j];
+                EXPECT_LT((before.origin + before.direction * before.length - v.position).length(), 1e-3f);
+                EXPECT_LT((before.direction - v.direction).length(), 1e-5f);
+                for (int c = 0; c < 3; ++c)
+                    EXPECT_NEAR(v.weight[c], before.flux[c] * sigmaS[c] / (sigmaS[c] + sigmaA[c]), 1e-5f * before.flux[c]);
+                if (j + 1 < vrls.size()) {
+                    EXPECT_LT((vrls[j + 1].origin - v.position).length(), 1e-4f);
+                }
+            }
+            // Unlimited: every VRL ends at a collision, where the path scatters (and may then end in roulette).
+            if (maxDepth < 0) {
+                EXPECT_EQ(vertices.size(), vrls.size()) << "path " << i;
+            }
+        }
+        EXPECT_GT(visited, 200u);
+    }
+}
+
 }  // namespace
 }  // namespace vrl
