@@ -5,10 +5,12 @@
 #include "render/vrl/light_tracer.h"
 
 #include <tbb/blocked_range.h>
+#include <spdlog/spdlog.h>
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
 #include <array>
+#include <atomic>
 #include <cmath>
 #include <string>
 #include <stdexcept>
@@ -28,15 +30,17 @@ struct Splat {
 };
 
 // Part 1: every light path's scattering vertices connected to the camera, summed
-// into `sum` (not yet divided by the path count).
-void traceToCamera(const Scene& scene, const LightTracingReferenceSettings& settings,
-                   std::vector<std::array<double, 3>>& sum) {
+// into `sum` (not yet divided by the path count). Returns how many connections had
+// a non-finite value and were left out (none in a sound scene: see the caller).
+uint64_t traceToCamera(const Scene& scene, const LightTracingReferenceSettings& settings,
+                       std::vector<std::array<double, 3>>& sum) {
     const PerspectiveCamera& camera = scene.camera();
     LightTracingSettings tracing;
     tracing.seed = settings.seed;
     tracing.maxDepth = settings.maxDepth;
     const LightPathWalker walker(scene, tracing);
     const float footprint = settings.pixelFootprint, perArea = 1.0f / (footprint * footprint);
+    std::atomic<uint64_t> nonFinite{0};
     const auto connect = [&](const LightPathVertex& v, std::vector<Splat>& out) {
         const auto seen = camera.project(v.position);
         if (!seen || !(seen->distance > 0.0f)) return;
@@ -57,7 +61,10 @@ void traceToCamera(const Scene& scene, const LightTracingReferenceSettings& sett
         const Rgb tr = scene.transmittance(from, seen->rayOrigin, medium);
         if (isBlack(tr)) return;
         const Rgb value = v.weight * f * tr * (seen->importance * perArea / (seen->distance * seen->distance));
-        if (!isFinite(value)) return;  // a vertex on the pinhole itself
+        if (!isFinite(value)) {  // project() keeps the vertex beyond the near clip plane: a NaN or inf from upstream
+            nonFinite.fetch_add(1, std::memory_order_relaxed);
+            return;
+        }
         out.push_back({uint32_t(seen->y) * uint32_t(camera.width()) + uint32_t(seen->x), value});
     };
     std::vector<std::vector<Splat>> chunks(kChunksPerBatch);
@@ -74,21 +81,35 @@ void traceToCamera(const Scene& scene, const LightTracingReferenceSettings& sett
             for (const Splat& s : chunk)
                 for (int k = 0; k < 3; ++k) sum[s.pixel][size_t(k)] += double(s.value[k]);
     }
+    return nonFinite.load();
 }
 
 }  // namespace
 
 Image renderLightTracingReference(const Scene& scene, const LightTracingReferenceSettings& settings) {
-    if (settings.samplesPerPixel < 0) throw std::invalid_argument("samples per pixel must not be negative");
+    const auto invalid = [](const std::string& what) {
+        return std::invalid_argument("light-tracing reference: " + what);
+    };
+    if (settings.samplesPerPixel < 0)
+        throw invalid("samples per pixel must not be negative, not " + std::to_string(settings.samplesPerPixel));
+    if (settings.maxDepth < -1)
+        throw invalid("the maximum depth must be -1 (unlimited) or at least 0, not " + std::to_string(settings.maxDepth));
     if (!(settings.pixelFootprint > 0.0f && settings.pixelFootprint <= 1.0f))
-        throw std::invalid_argument("the light-tracing pixel footprint must be in (0, 1], not " +
-                                    std::to_string(settings.pixelFootprint));
+        throw invalid("the pixel footprint must be in (0, 1], not " + std::to_string(settings.pixelFootprint));
+    if (settings.pixelFootprint < 1.0f && !settings.pixelCentres && settings.samplesPerPixel > 0)
+        throw invalid("a pixel footprint below 1 measures near pixel centres, so part 2 must trace through them "
+                      "too (pixelCentres); jittered, it would average over whole pixels");
     if (settings.lightPaths == 0 && settings.samplesPerPixel == 0)
-        throw std::invalid_argument("the light-tracing reference needs light paths, camera samples or both");
+        throw invalid("it needs light paths, camera samples or both; both are 0");
     const PerspectiveCamera& camera = scene.camera();
     const int width = camera.width(), height = camera.height();
     std::vector<std::array<double, 3>> lightSum(size_t(width) * size_t(height), {0.0, 0.0, 0.0});
-    if (settings.lightPaths > 0) traceToCamera(scene, settings, lightSum);
+    if (settings.lightPaths > 0)
+        if (const uint64_t dropped = traceToCamera(scene, settings, lightSum); dropped > 0)
+            spdlog::warn("light-tracing reference: {} of the camera connections of {} light paths had a NaN or "
+                         "infinite value and were left out; the image lacks their light (a degenerate emitter, "
+                         "BSDF or medium in the scene?)",
+                         dropped, settings.lightPaths);
 
     Image image(width, height);
     const double perPath = settings.lightPaths > 0 ? 1.0 / double(settings.lightPaths) : 0.0;

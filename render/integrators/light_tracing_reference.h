@@ -31,7 +31,9 @@
 //      the full path tracer.
 // The two parts are disjoint and cover every path, so their sum is the image
 // the path tracer estimates with jittered rays: both parts average over each
-// pixel's area. Light tracing's noise is spread over the image evenly and does
+// pixel's area. Except where the path tracer cannot sample a path at all: light
+// from a point or spot light that reaches a scattering vertex only through Dirac
+// surfaces (its caustics through glass) has zero density for it and is found here. Light tracing's noise is spread over the image evenly and does
 // not depend on how small the light is; part 2 keeps the path tracer's noise
 // only where the camera sees specular surfaces.
 //
@@ -47,6 +49,16 @@
 // measurement over the smaller area): its difference from the centre value
 // shrinks as f (at an edge) or f^2 (where the image is smooth), its variance
 // grows as 1 / f^2.
+//
+// Variance near the lens: a connection from a medium vertex at distance d from the
+// pinhole carries 1 / d^2, so with the camera in a medium the variance grows as
+// 1 / nearClip (the fog within r of the pinhole adds ~ r to a pixel's value but
+// ~ 1 / nearClip - 1 / r to its variance). A render then typically misses the
+// rare, large connections from the fog just in front of the lens and comes out low
+// by about that fog's in-scatter, which the spread of a few renders does not show
+// (light_tracing_reference_test.cpp: 9% in a dim block of a test room with
+// nearClip 1e-4). The volumetric caustic's camera is 6 units in front of its lit
+// box, where that fog is dim.
 //
 // Deterministic: light path i draws from (seed, i) and its connections are
 // summed in a fixed order of chunks; camera sample s of pixel p from
@@ -66,12 +78,15 @@ struct LightTracingReferenceSettings {
     uint64_t seed = 0;
     int maxDepth = -1;  // Mitsuba's meaning (path_tracer.h), for both parts
     bool pixelCentres = false;  // part 2's rays through pixel centres (see above); else jittered
-    float pixelFootprint = 1.0f;  // part 1: the centred fraction of each pixel's width it averages over, (0, 1]
+    float pixelFootprint = 1.0f;  // part 1: the centred fraction of each pixel's width it averages over, (0, 1];
+                                  // below 1 only with pixelCentres
 };
 
 // The image (the crop window when the camera has one). Throws
-// std::invalid_argument when both parts are left out, spp is negative or the
-// footprint is outside (0, 1].
+// std::invalid_argument when both parts are left out, spp is negative, maxDepth is
+// below -1, the footprint is outside (0, 1], or below 1 while part 2 is jittered
+// (the two parts would measure different things). A connection whose value is not
+// finite (none in a sound scene) is left out and counted in a warning on stderr.
 Image renderLightTracingReference(const Scene& scene, const LightTracingReferenceSettings& settings);
 
 }  // namespace vrl

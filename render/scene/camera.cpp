@@ -11,6 +11,7 @@ PerspectiveCamera::PerspectiveCamera(const SensorDescription& sensor)
     : worldFromCamera_(sensor.toWorld),
       cameraFromWorld_(sensor.toWorld.inverse()),
       position_(sensor.toWorld.applyPoint(Vec3(0.0f))),
+      viewAxis_(sensor.toWorld.applyVector(Vec3(0.0f, 0.0f, 1.0f)).normalized()),
       width_(sensor.width),
       height_(sensor.height),
       crop_(sensor.crop ? checkFilmCrop(*sensor.crop, sensor.width, sensor.height) : std::nullopt),
@@ -41,9 +42,12 @@ Ray PerspectiveCamera::generateRay(float filmX, float filmY) const {
 }
 
 std::optional<PerspectiveCamera::Projection> PerspectiveCamera::project(const Vec3& p) const {
-    const Vec3 local = cameraFromWorld_.applyPoint(p);
-    if (!(local.z > nearClip_ && local.z < farClip_)) return std::nullopt;
-    // generateRay's inverse: local direction (-ndcX tanHalfX, -ndcY tanHalfY, 1).
+    const Vec3 toP = p - position_;
+    const float depth = toP.dot(viewAxis_);  // world units, as generateRay's clip distances
+    if (!(depth > nearClip_ && depth < farClip_)) return std::nullopt;
+    // generateRay's inverse: local direction (-ndcX tanHalfX, -ndcY tanHalfY, 1); a
+    // uniform scale of the sensor transform cancels in the ratios.
+    const Vec3 local = cameraFromWorld_.applyVector(toP);
     const float filmX = (1.0f - local.x / (local.z * tanHalfX_)) * 0.5f * float(width_);
     const float filmY = (1.0f - local.y / (local.z * tanHalfY_)) * 0.5f * float(height_);
     const float imageX = filmX - float(cropX0()), imageY = filmY - float(cropY0());
@@ -53,10 +57,9 @@ std::optional<PerspectiveCamera::Projection> PerspectiveCamera::project(const Ve
     out.y = std::min(int(imageY), height() - 1);
     out.offsetX = imageX - float(out.x) - 0.5f;
     out.offsetY = imageY - float(out.y) - 0.5f;
-    const Vec3 toP = p - position_;
     out.distance = toP.length();
-    const float cosTheta = local.z / local.length();
-    out.rayOrigin = position_ + toP * (nearClip_ / local.z);  // at camera depth nearClip, as generateRay's
+    const float cosTheta = depth / out.distance;
+    out.rayOrigin = position_ + toP * (nearClip_ / depth);  // at depth nearClip, where generateRay's rays start
     const float pixelArea = (2.0f * tanHalfX_ / float(width_)) * (2.0f * tanHalfY_ / float(height_));
     out.importance = 1.0f / (pixelArea * cosTheta * cosTheta * cosTheta);
     return out;

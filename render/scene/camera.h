@@ -51,7 +51,9 @@ public:
     // as jittered rays average), and dA = dw / cos^3(theta), theta the angle to the
     // viewing axis. A point source of intensity I at distance d then adds
     // I / (d^2 A cos^3 theta) to its pixel: `importance` is 1 / (A cos^3 theta).
-    // (Rigid or uniformly scaled sensor transforms; Mitsuba's look-at ones are.)
+    // Depths and clip distances are in world units along the viewing axis, as
+    // generateRay's, so a sensor transform that is rigid up to a uniform scale or a
+    // mirror (Mitsuba's <scale x="-1"/>) projects consistently; look-at ones are rigid.
     struct Projection {
         int x = 0, y = 0;  // image pixel (of the crop window when there is one)
         float offsetX = 0.0f, offsetY = 0.0f;  // where in that pixel, from its centre, in [-0.5, 0.5)
@@ -75,6 +77,7 @@ private:
     Transform worldFromCamera_;
     Transform cameraFromWorld_;
     Vec3 position_;
+    Vec3 viewAxis_;  // unit world direction of camera-space +z
     int width_, height_;  // the film
     std::optional<FilmCrop> crop_;
     float tanHalfX_, tanHalfY_;

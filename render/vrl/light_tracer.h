@@ -58,7 +58,9 @@ struct LightPathVertex {
     Vec3 direction;  // the direction the path travels in as it arrives
     Rgb weight{0.0f};
     int medium = -1;                      // the medium the path arrives through
-    const SurfaceHit* surface = nullptr;  // null for a medium vertex
+    // Null for a medium vertex; else the walker's own hit record, valid only
+    // during the visit call (copy it to keep it).
+    const SurfaceHit* surface = nullptr;
     // Scattering vertices on the path up to this one, itself included: connected
     // to the camera, it makes a camera path of depth + 1 segments.
     int depth = 0;

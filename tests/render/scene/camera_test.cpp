@@ -185,30 +185,37 @@ TEST(CameraTest, CropWindowKeepsFilmPixelsAndItsNdcSpansTheWindow) {
 }
 
 // project() inverts generateRay: a point on the ray through film position (fx, fy)
-// lands in the pixel holding (fx, fy) (of the crop window), its camera ray starts
-// where generateRay's does, and points off the image, behind the camera or before
-// the near clip plane are not seen.
+// lands in the pixel holding (fx, fy) (of the crop window) at offset (fx, fy) minus
+// that pixel's centre, its camera ray starts where generateRay's does, and points
+// off the image, behind the camera or before the near clip plane are not seen; for
+// a look-at sensor, the same scaled by 2.5 (clip distances stay world units along
+// the ray) and one mirrored by Mitsuba's <scale x="-1"/>.
 TEST(CameraTest, ProjectFindsThePixelAndTheRayOfAPoint) {
-    for (const bool cropped : {false, true}) {
-        SensorDescription sensor = tiltedSensor(64, 48, 53.0f, FovAxis::X);
-        sensor.nearClip = 0.5f;
-        if (cropped) sensor.crop = FilmCrop{10, 6, 20, 12};
-        const PerspectiveCamera camera(sensor);
-        for (const auto& [fx, fy] : {std::pair{10.5f, 6.25f}, std::pair{29.9f, 17.1f}, std::pair{17.5f, 9.75f}}) {
-            const Ray ray = camera.generateRay(fx, fy);
-            const Vec3 point = ray.origin + ray.direction * 7.0f;
-            const auto seen = camera.project(point);
-            ASSERT_TRUE(seen) << fx << ", " << fy;
-            EXPECT_EQ(seen->x, int(fx) - camera.cropX0());
-            EXPECT_EQ(seen->y, int(fy) - camera.cropY0());
-            EXPECT_LT((seen->rayOrigin - ray.origin).length(), 1e-4f);
-            EXPECT_NEAR(seen->distance, (point - camera.position()).length(), 1e-4f);
-            EXPECT_FALSE(camera.project(camera.position() - (point - camera.position())));  // behind
-            EXPECT_FALSE(camera.project(camera.position() + ray.direction * 0.3f));  // before the near clip plane
+    const Transform scaled = Transform::scale(Vec3(2.5f)), mirrored = Transform::scale(Vec3(-1.0f, 1.0f, 1.0f));
+    for (const Transform* local : {static_cast<const Transform*>(nullptr), &scaled, &mirrored})
+        for (const bool cropped : {false, true}) {
+            SensorDescription sensor = tiltedSensor(64, 48, 53.0f, FovAxis::X);
+            if (local) sensor.toWorld = local->then(sensor.toWorld);
+            sensor.nearClip = 0.5f;
+            if (cropped) sensor.crop = FilmCrop{10, 6, 20, 12};
+            const PerspectiveCamera camera(sensor);
+            for (const auto& [fx, fy] : {std::pair{10.5f, 6.25f}, std::pair{29.9f, 17.1f}, std::pair{17.5f, 9.75f}}) {
+                const Ray ray = camera.generateRay(fx, fy);
+                const Vec3 point = ray.origin + ray.direction * 7.0f;
+                const auto seen = camera.project(point);
+                ASSERT_TRUE(seen) << fx << ", " << fy;
+                EXPECT_EQ(seen->x, int(fx) - camera.cropX0());
+                EXPECT_EQ(seen->y, int(fy) - camera.cropY0());
+                EXPECT_NEAR(seen->offsetX, fx - std::floor(fx) - 0.5f, 1e-3f);
+                EXPECT_NEAR(seen->offsetY, fy - std::floor(fy) - 0.5f, 1e-3f);
+                EXPECT_LT((seen->rayOrigin - ray.origin).length(), 1e-4f);
+                EXPECT_NEAR(seen->distance, (point - camera.position()).length(), 1e-4f);
+                EXPECT_FALSE(camera.project(camera.position() - (point - camera.position())));  // behind
+                EXPECT_FALSE(camera.project(camera.position() + ray.direction * 0.3f));  // before the near clip plane
+            }
+            const Ray off = camera.generateRay(cropped ? 5.0f : -0.5f, 20.0f);  // left of the crop window, or of the film
+            EXPECT_FALSE(camera.project(off.origin + off.direction * 3.0f));
         }
-        const Ray off = camera.generateRay(cropped ? 5.0f : -0.5f, 20.0f);  // left of the crop window, or of the film
-        EXPECT_FALSE(camera.project(off.origin + off.direction * 3.0f));
-    }
 }
 
 // The importance is the pinhole's We for a box filter over the pixel: integrated

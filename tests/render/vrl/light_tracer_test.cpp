@@ -9,6 +9,7 @@
 #include <gtest/gtest.h>
 #include <tbb/task_arena.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 
@@ -142,7 +143,8 @@ TEST(LightTracer, MaxDepthBelowThreeDepositsNothing) {
 // medium (no null collisions) each medium vertex of path i is where one of its VRLs
 // ends and the next begins, numbered 1, 2, ... along the path, with the flux of
 // the VRL that ends there times sigma_s / sigma_t; and walk stops at the vertices
-// whose camera connection would exceed maxDepth (depth + 1 <= maxDepth).
+// whose camera connection would exceed maxDepth (depth + 1 <= maxDepth), not before
+// (some path reaches depth maxDepth - 1).
 TEST(LightTracer, WalkVisitsTheVerticesBetweenThePathsVrls) {
     const Rgb sigmaS(0.5f), sigmaA(0.1f);
     const auto scene = Scene::build(test::pointLightInInfiniteMedium(Rgb(1.0f), Vec3(0.0f), sigmaS, sigmaA, 0.3f));
@@ -152,6 +154,7 @@ TEST(LightTracer, WalkVisitsTheVerticesBetweenThePathsVrls) {
         settings.maxDepth = maxDepth;
         const LightPathWalker walker(*scene, settings);
         size_t visited = 0;
+        int deepest = 0;
         for (uint64_t i = 0; i < 200; ++i) {
             std::vector<Vrl> vrls;
             walker.deposit(i, vrls);
@@ -162,6 +165,7 @@ TEST(LightTracer, WalkVisitsTheVerticesBetweenThePathsVrls) {
                 const LightPathVertex& v = vertices[j];
                 EXPECT_EQ(v.depth, int(j) + 1);
                 EXPECT_EQ(v.surface, nullptr);
+                deepest = std::max(deepest, v.depth);
                 if (maxDepth > 0) {
                     EXPECT_LE(v.depth + 1, maxDepth);
                 }
@@ -182,6 +186,9 @@ TEST(LightTracer, WalkVisitsTheVerticesBetweenThePathsVrls) {
             }
         }
         EXPECT_GT(visited, 200u);
+        if (maxDepth > 0) {
+            EXPECT_EQ(deepest, maxDepth - 1);
+        }
     }
 }
 
