@@ -4,8 +4,8 @@
 #include "render/integrators/path_tracer.h"
 #include "render/vrl/light_tracer.h"
 
-#include <tbb/blocked_range.h>
 #include <spdlog/spdlog.h>
+#include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
 #include <algorithm>

@@ -33,9 +33,10 @@
 // the path tracer estimates with jittered rays: both parts average over each
 // pixel's area. Except where the path tracer cannot sample a path at all: light
 // from a point or spot light that reaches a scattering vertex only through Dirac
-// surfaces (its caustics through glass) has zero density for it and is found here. Light tracing's noise is spread over the image evenly and does
-// not depend on how small the light is; part 2 keeps the path tracer's noise
-// only where the camera sees specular surfaces.
+// surfaces (its caustics through glass) has zero density for it and is found
+// here. Light tracing's noise is spread over the image evenly and does not depend
+// on how small the light is; part 2 keeps the path tracer's noise only where the
+// camera sees specular surfaces.
 //
 // For comparison with renders through pixel centres (RenderSettings::jitter =
 // false, the report's runs), an average over the pixel differs where the image

@@ -148,6 +148,16 @@ SceneDescription glassAndMirrorRoom(const Rgb& sigmaS, const Rgb& sigmaA, float 
     return scene;
 }
 
+SceneDescription withoutPointLights(SceneDescription scene) {
+    scene.emitters.clear();  // area lights live on their shapes
+    return scene;
+}
+
+SceneDescription withoutAreaLights(SceneDescription scene) {
+    for (ShapeDescription& shape : scene.shapes) shape.areaRadiance.reset();
+    return scene;
+}
+
 SceneDescription glossyLitRoom(const Rgb& sigmaS, const Rgb& sigmaA, float g, const Rgb& sigmaS2) {
     SceneDescription scene = litRoomWithOccluder(sigmaS, sigmaA, g);
     BsdfDescription roughPlastic;

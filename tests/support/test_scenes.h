@@ -61,6 +61,16 @@ SceneDescription glassAndMirrorRoom(const Rgb& sigmaS, const Rgb& sigmaA, float 
 // absorption) below it, so paths to the light cross null boundaries.
 SceneDescription glossyLitRoom(const Rgb& sigmaS, const Rgb& sigmaA, float g, const Rgb& sigmaS2);
 
+// The scene without its point and spot lights. A point light's light that reaches
+// a scattering vertex only through Dirac surfaces (its caustics through glass, off
+// a smooth coating) has zero density in the path tracer: next-event estimation
+// cannot cross a Dirac surface and a sampled direction never hits a point. Tests
+// that compare light-side estimators (VRLs, light tracing) with the path tracer in
+// rooms with Dirac surfaces light them by their area lights alone.
+SceneDescription withoutPointLights(SceneDescription scene);
+// The scene without its area lights (the emitters attached to shapes).
+SceneDescription withoutAreaLights(SceneDescription scene);
+
 // Vacuum: a rough-conductor floor (Beckmann `alpha`, y = 0 facing up) under a
 // 1.2 x 1.2 area light facing down at height 1.5; the camera (16 x 12) sees the
 // light's glossy reflection. Direct lighting on a glossy surface: the case where

@@ -177,33 +177,22 @@ double expectSameImageAsPathTracer(const Scene& scene, const char* what, int max
     return visible;
 }
 
-// Light from a point or spot light that reaches the camera only through Dirac
-// surfaces (the spot light refracted by the glass sphere or reflected by a smooth
-// coating) has zero density in the path tracer: next-event estimation cannot cross
-// the Dirac surface, and a BSDF or phase sample never hits a point. Light tracing
-// finds it. So the comparisons with the path tracer in rooms with Dirac surfaces
-// light them by the area light alone (FindsTheSpotLightsCausticsThePathTracerCannot
-// shows the difference), and the spot light is compared in the diffuse room.
-SceneDescription withoutPointLights(SceneDescription scene) {
-    scene.emitters.clear();
-    return scene;
-}
+// The comparisons with the path tracer in rooms with Dirac surfaces light them by
+// the area light alone (test::withoutPointLights: the path tracer cannot sample a
+// spot light's caustics; FindsTheSpotLightsCausticsThePathTracerCannot shows the
+// difference), and the spot light is compared in the diffuse room.
 
 // The spot light alone in a medium-filled room with diffuse walls and an occluder
 // (no Dirac surface): part 1 from a point emitter. The spot is moved behind the
 // camera: the path tracer's own errors are unreliable next to a light, where
 // next-event estimation from the fog carries 1 / d^2 and is heavy-tailed as light
-// tracing is next to the lens (at its place in the room, 0.8 in front of the camera,
-// one block read light tracing 4.55 standard errors above; with the area light too, a block
-// read 0.0710 at 16,384 paths a pixel and 0.0717 at 131,072, standard errors 4e-4
-// and 2e-4).
-SceneDescription withoutAreaLights(SceneDescription scene) {
-    for (ShapeDescription& shape : scene.shapes) shape.areaRadiance.reset();
-    return scene;
-}
+// tracing is next to the lens (at its place in the room, 0.8 in front of the
+// camera, one block read light tracing 4.55 standard errors above; with the area
+// light too, a block read 0.0710 at 16,384 paths a pixel and 0.0717 at 131,072,
+// standard errors 4e-4 and 2e-4).
 TEST(LightTracingReference, EqualsPathTracerInDiffuseRoomWithSpotLight) {
     SceneDescription description =
-        awayFromThePinhole(withoutAreaLights(test::litRoomWithOccluder(Rgb(0.3f, 0.4f, 0.5f), Rgb(0.05f), 0.3f)));
+        awayFromThePinhole(test::withoutAreaLights(test::litRoomWithOccluder(Rgb(0.3f, 0.4f, 0.5f), Rgb(0.05f), 0.3f)));
     ASSERT_EQ(description.emitters.size(), 1u);
     description.emitters[0].toWorld =
         Transform::lookAt(Vec3(0.2f, 1.2f, -1.95f), Vec3(0.2f, -2.0f, 0.8f), Vec3(0, 0, 1));  // behind the camera
@@ -216,7 +205,7 @@ TEST(LightTracingReference, EqualsPathTracerInDiffuseRoomWithSpotLight) {
 // rest by light tracing (part 1); the camera is inside the medium.
 TEST(LightTracingReference, EqualsPathTracerInGlassAndMirrorRoom) {
     const auto scene = Scene::build(
-        awayFromThePinhole(withoutPointLights(test::glassAndMirrorRoom(Rgb(0.3f, 0.4f, 0.5f), Rgb(0.05f), 0.3f))));
+        awayFromThePinhole(test::withoutPointLights(test::glassAndMirrorRoom(Rgb(0.3f, 0.4f, 0.5f), Rgb(0.05f), 0.3f))));
     // The blocks that see the glass and the mirror: part 2 is many standard errors there
     // (measured 14 in this build, 12 in the sanitizer build's quarter).
     EXPECT_GT(expectSameImageAsPathTracer(*scene, "glass and mirror room"), kTolerance);
@@ -228,7 +217,7 @@ TEST(LightTracingReference, EqualsPathTracerInGlassAndMirrorRoom) {
 // where the path tracer does (the report's references use maxDepth 12).
 TEST(LightTracingReference, EqualsPathTracerAtFiniteMaximumDepths) {
     const auto scene = Scene::build(
-        awayFromThePinhole(withoutPointLights(test::glassAndMirrorRoom(Rgb(0.3f, 0.4f, 0.5f), Rgb(0.05f), 0.3f))));
+        awayFromThePinhole(test::withoutPointLights(test::glassAndMirrorRoom(Rgb(0.3f, 0.4f, 0.5f), Rgb(0.05f), 0.3f))));
     for (const int maxDepth : {2, 3}) (void)expectSameImageAsPathTracer(*scene, "glass and mirror room", maxDepth);
 }
 
@@ -236,7 +225,7 @@ TEST(LightTracingReference, EqualsPathTracerAtFiniteMaximumDepths) {
 // parts at one vertex), a rough conductor, and a null-bounded box of a second medium.
 TEST(LightTracingReference, EqualsPathTracerInGlossyRoomWithNullBoundaries) {
     const auto scene = Scene::build(awayFromThePinhole(
-        withoutPointLights(test::glossyLitRoom(Rgb(0.15f, 0.2f, 0.25f), Rgb(0.02f), 0.3f, Rgb(0.8f)))));
+        test::withoutPointLights(test::glossyLitRoom(Rgb(0.15f, 0.2f, 0.25f), Rgb(0.02f), 0.3f, Rgb(0.8f)))));
     (void)expectSameImageAsPathTracer(*scene, "glossy room");
 }
 
@@ -249,7 +238,7 @@ TEST(LightTracingReference, EqualsPathTracerInGlossyRoomWithNullBoundaries) {
 // (measured 13.5 and 12.3 with two sets of seeds; 6.2 in the sanitizer build's).
 TEST(LightTracingReference, FindsTheSpotLightsCausticsThePathTracerCannot) {
     const auto scene = Scene::build(
-        awayFromThePinhole(withoutAreaLights(test::glassAndMirrorRoom(Rgb(0.3f, 0.4f, 0.5f), Rgb(0.05f), 0.3f))));
+        awayFromThePinhole(test::withoutAreaLights(test::glassAndMirrorRoom(Rgb(0.3f, 0.4f, 0.5f), Rgb(0.05f), 0.3f))));
     ASSERT_FALSE(scene->emitters().empty());
     LightTracingReferenceSettings settings;
     settings.lightPaths = 50000 / uint64_t(test::kSanitizedWorkDivisor);

@@ -148,15 +148,13 @@ TEST(VrlImage, PartsSumToReferenceInMediumOnlyScene) {
 
 // Camera paths continue through glass and a mirror (camera_segment.h); light
 // paths refract into volumetric caustics. Grey medium only, to keep the time down.
-// The room's area light only: its spot light's caustics through the glass reach the
-// VRLs but have zero density in the path tracer (next-event estimation cannot cross
-// the glass, a sampled direction never hits a point), so with it the reference
+// The room's area light only (test::withoutPointLights): its spot light's caustics
+// through the glass reach the VRLs but not the path tracer, so with it the reference
 // would lack light the VRL image has (light_tracing_reference_test.cpp measures it).
 TEST(VrlImage, PartsSumToReferenceThroughGlassAndMirror) {
     const MediumCase& m = kMedia[0];
-    SceneDescription description = test::glassAndMirrorRoom(m.sigmaS * 0.5f, m.sigmaA * 0.5f, m.g);
-    description.emitters.clear();
-    const auto scene = Scene::build(description);
+    const auto scene =
+        Scene::build(test::withoutPointLights(test::glassAndMirrorRoom(m.sigmaS * 0.5f, m.sigmaA * 0.5f, m.g)));
     ASSERT_TRUE(scene->hasSpecularSurfaces());
     expectAgree(vrlRuns(*scene, kAllParts, kPartsSpp, kVrls),
                 referenceRuns(*scene, kReferenceSpp, false), "glass and mirror");
