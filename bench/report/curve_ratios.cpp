@@ -30,7 +30,8 @@ std::optional<double> errorAtTime(const std::vector<CurvePoint>& curve, double s
 
 std::optional<double> timeToError(const std::vector<CurvePoint>& curve, double error) {
     if (curve.empty() || !(error > 0.0)) return std::nullopt;
-    if (curve.front().error <= error) return curve.front().seconds;
+    if (curve.front().error == error) return curve.front().seconds;
+    if (curve.front().error < error) return std::nullopt;  // reached before the first point: not measured
     for (size_t i = 0; i + 1 < curve.size(); ++i) {
         const CurvePoint &a = curve[i], &b = curve[i + 1];
         if (!(b.error <= error)) continue;  // a.error > error >= b.error: the first crossing

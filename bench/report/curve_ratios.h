@@ -22,7 +22,9 @@ std::vector<CurvePoint> cleanCurve(std::vector<CurvePoint> points);
 std::optional<double> errorAtTime(const std::vector<CurvePoint>& curve, double seconds);
 
 // The earliest time at which the curve reaches `error` or less (interpolating
-// log-log on the first segment that crosses it); empty if it never does.
+// log-log on the first segment that crosses it); empty if it never does, and
+// empty if its first (cheapest) point is already below `error`: the time is then
+// somewhere before the measured range, and a ratio to it would be a guess.
 std::optional<double> timeToError(const std::vector<CurvePoint>& curve, double error);
 
 }  // namespace vrl::report

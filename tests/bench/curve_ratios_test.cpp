@@ -33,4 +33,5 @@ TEST(CurveRatios, TimeToErrorTakesTheFirstCrossing) {
     // Between (16, 4) and (64, 0.5): 1 is 2/3 of the way in log error, so t = 16 * 4^(2/3).
     EXPECT_NEAR(*timeToError(c, 1.0), 16.0 * std::pow(4.0, 2.0 / 3.0), 1e-9);
     EXPECT_FALSE(timeToError(c, 0.25));               // never reached
+    EXPECT_FALSE(timeToError(c, 9.0));                // reached before the first point: never extrapolated
 }

@@ -64,6 +64,14 @@ awk -F'|' '/^\| VRL Lightcuts point/ { table = 1; next }
            table && !/^\|/ { table = 0 }
            table && $2 ~ /‡/ { for (i = 4; i < NF; ++i) if ($i !~ /^ *‡ *$/) { print "ratio below noise: " $0; exit 1 } }' \
     "$out/summary.md" || fail "a ratio was given for a run below the noise floor"
+# The same ratios read at the other methods' points: one table per scene and part,
+# and no ratio for a point below the noise floor.
+[ "$(grep -c "^The same ratios at the other methods' points" "$out/summary.md")" -eq 3 ] \
+    || fail "summary.md should compare at the other methods' points per scene and part"
+awk -F'|' '/^\| method \| point \|/ { table = 1; next }
+           table && !/^\|/ { table = 0 }
+           table && $3 ~ /‡/ { for (i = 5; i < NF; ++i) if ($i !~ /^ *‡ *$/) { print "ratio below noise: " $0; exit 1 } }' \
+    "$out/summary.md" || fail "a ratio was given at another method's point below the noise floor"
 [ "$(grep -c '^bathroom,' "$out/speedup.csv")" -ge 6 ] || fail "speedup.csv rows"
 # Figure 4 also has the stochastic cut, timed at the deterministic cut's error.
 [ "$(grep -c '^bathroom,VRL-stochastic,' "$out/speedup.csv")" -eq 2 ] || fail "no stochastic speed-up rows"
