@@ -184,14 +184,12 @@ std::vector<BenchmarkScene> benchmarkScenes(bool quick, const std::filesystem::p
         // cheapest; 33 s on bathroom), one point at which the equal-time comparison
         // reads VRL Lightcuts' curve; part (d) alone, where the paper compares, has all
         // of its points.
-        const auto firstVpl = std::find_if(s.runs.begin(), s.runs.end(), [](const MethodRun& r) {
+        const auto vplWholeImage = [](const MethodRun& r) {
             return r.method == RenderMethod::VplLightcuts && !r.multipleOnly;
-        });
-        const MethodRun keep = firstVpl != s.runs.end() ? *firstVpl : MethodRun{};
-        std::erase_if(s.runs, [&](const MethodRun& r) {
-            return r.method == RenderMethod::VplLightcuts && !r.multipleOnly &&
-                   !(r.lights == keep.lights && r.spp == keep.spp);
-        });
+        };
+        const auto firstVpl = std::find_if(s.runs.begin(), s.runs.end(), vplWholeImage);
+        if (firstVpl != s.runs.end())
+            s.runs.erase(std::remove_if(std::next(firstVpl), s.runs.end(), vplWholeImage), s.runs.end());
         for (const auto& r : multipleSweep(false)) s.runs.push_back(r);
         s.tableLights = 10000;
         return s;
