@@ -1,7 +1,11 @@
 #include "bench/report/benchmark_scenes.h"
 
+#include "util/hash.h"
+
 #include <algorithm>
 #include <cstdio>
+#include <set>
+#include <stdexcept>
 #include <tuple>
 
 namespace vrl::report {
@@ -123,6 +127,25 @@ std::string MethodRun::curve() const {
     return name;
 }
 
+uint64_t MethodRun::seed(const std::string& scene) const {
+    const std::string digest = util::sha256Hex(scene + "\n" + curve() + "\n" + label());
+    return std::stoull(digest.substr(0, 16), nullptr, 16);
+}
+
+namespace {
+
+std::vector<BenchmarkScene> checkedRuns(std::vector<BenchmarkScene> scenes) {
+    for (const BenchmarkScene& s : scenes) {
+        std::set<std::pair<std::string, std::string>> seen;
+        for (const MethodRun& r : s.runs)
+            if (!seen.emplace(r.curve(), r.label()).second)
+                throw std::logic_error("benchmark scene " + s.name + " runs " + r.curve() + " " + r.label() + " twice");
+    }
+    return scenes;
+}
+
+}  // namespace
+
 std::vector<BenchmarkScene> benchmarkScenes(bool quick, const std::filesystem::path& repository,
                                             const std::filesystem::path& shared) {
     std::vector<BenchmarkScene> scenes;
@@ -167,7 +190,7 @@ std::vector<BenchmarkScene> benchmarkScenes(bool quick, const std::filesystem::p
         hg.speedupLights.clear();
         scenes.push_back(hg);
     }
-    if (quick) return scenes;
+    if (quick) return checkedRuns(std::move(scenes));
 
     const auto paper = [&](std::string name, std::string description, std::filesystem::path file, std::string medium,
                            int width, int height, int referenceSpp) {
@@ -206,7 +229,7 @@ std::vector<BenchmarkScene> benchmarkScenes(bool quick, const std::filesystem::p
     // camera does not depend on the light's size; the path tracer keeps the pixels
     // that see the sphere.
     scenes.back().referenceLightPaths = 256000000;
-    return scenes;
+    return checkedRuns(std::move(scenes));
 }
 
 }  // namespace vrl::report

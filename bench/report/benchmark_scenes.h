@@ -27,6 +27,10 @@ struct MethodRun {
     std::string label() const;  // no commas (a CSV field)
     // The curve the run belongs to: method, and threshold or cut size where a method has several.
     std::string curve() const;
+    // The run's seed in scene `scene`: a hash of the scene's name, the curve and the
+    // label, so that every run has its own random streams (no two share the noise of
+    // parts (a)-(c)) and keeps them when runs are added to or removed from the sweep.
+    uint64_t seed(const std::string& scene) const;
 };
 
 struct BenchmarkScene {
@@ -57,7 +61,8 @@ struct BenchmarkScene {
 };
 
 // The scene list. `repository`: the source tree (for scenes/); `shared`: the
-// shared scene folder (may not exist).
+// shared scene folder (may not exist). No two runs of a scene have the same curve
+// and label (they would be the same render under the same seed).
 std::vector<BenchmarkScene> benchmarkScenes(bool quick, const std::filesystem::path& repository,
                                             const std::filesystem::path& shared);
 

@@ -1035,8 +1035,7 @@ int runReport(const Options& o) {
             std::map<std::string, std::string> lastLabel;
             for (const auto& run : s.runs) {
                 ++done;
-                // Every run its own seed: no two share the noise of parts (a)-(c).
-                const RenderSettings settings = settingsFor(s, run, 1 + (&run - s.runs.data()));
+                const RenderSettings settings = settingsFor(s, run, run.seed(s.name));
                 RenderStatistics stats;
                 const auto runStart = Clock::now();
                 ImageSet images = render(*scene, settings, {}, &stats);

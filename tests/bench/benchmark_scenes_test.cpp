@@ -1,0 +1,62 @@
+// The benchmark report's scene list: every run's seed is its own and does not
+// depend on where the run stands in the sweep.
+#include "bench/report/benchmark_scenes.h"
+
+#include <gtest/gtest.h>
+
+#include <set>
+
+using namespace vrl;
+using namespace vrl::report;
+
+namespace {
+
+// The full list names the shared scenes by path only (nothing is loaded here).
+std::vector<BenchmarkScene> scenes(bool quick) { return benchmarkScenes(quick, "/repository", "/shared"); }
+
+}  // namespace
+
+TEST(BenchmarkScenes, EveryRunOfEveryListHasItsOwnSeed) {
+    for (const bool quick : {true, false}) {
+        const auto list = scenes(quick);
+        ASSERT_GE(list.size(), quick ? 2u : 5u);
+        std::set<uint64_t> seeds;
+        size_t runs = 0;
+        for (const BenchmarkScene& s : list)
+            for (const MethodRun& r : s.runs) {
+                seeds.insert(r.seed(s.name));
+                ++runs;
+            }
+        EXPECT_EQ(seeds.size(), runs) << (quick ? "--quick" : "full");
+    }
+}
+
+TEST(BenchmarkScenes, ASeedDependsOnTheRunAndSceneNotOnItsPlace) {
+    const auto list = scenes(false);
+    const BenchmarkScene& bathroom = list.front();
+    ASSERT_GE(bathroom.runs.size(), 3u);
+    const MethodRun& last = bathroom.runs.back();
+    // The same run (same curve and label) in a shorter sweep keeps its seed...
+    std::vector<MethodRun> shorter(bathroom.runs.begin() + 1, bathroom.runs.end());
+    EXPECT_EQ(shorter.back().seed(bathroom.name), last.seed(bathroom.name));
+    // ...and changes it with the scene, the curve or the label.
+    EXPECT_NE(last.seed("another scene"), last.seed(bathroom.name));
+    MethodRun otherCurve = last;
+    otherCurve.multipleOnly = !otherCurve.multipleOnly;
+    EXPECT_NE(otherCurve.seed(bathroom.name), last.seed(bathroom.name));
+    MethodRun otherLabel = last;
+    otherLabel.spp += 1;
+    EXPECT_NE(otherLabel.seed(bathroom.name), last.seed(bathroom.name));
+}
+
+TEST(BenchmarkScenes, ASeedIsTheFirst64BitsOfTheSha256OfSceneCurveAndLabel) {
+    // Fixed across compilers and standard libraries (no std::hash): the report's
+    // runs are the same renders on any machine. The value is Python's
+    // int(hashlib.sha256(b"bathroom\npath\n4 spp").hexdigest()[:16], 16).
+    MethodRun run;
+    run.method = RenderMethod::Path;
+    run.spp = 4;
+    ASSERT_EQ(run.curve(), "path");
+    ASSERT_EQ(run.label(), "4 spp");
+    EXPECT_EQ(run.seed("bathroom"), 16721067455369837397ull);
+}
