@@ -51,10 +51,14 @@ struct BenchmarkScene {
     uint64_t referenceLightPaths = 0;
     // Part (d)'s reference: plain VRLs (1 spp) over independent VRL sets, so that it
     // converges to the true transport; partReferenceSets sets of partReferenceVrls
-    // VRLs in each of its 8 chunks of each half (measured on bathroom at 320x180:
+    // VRLs in each of its chunks of each half (measured on bathroom at 320x180:
     // for the same noise, 2x less time than stochastic VRL Lightcuts over sets).
     uint64_t partReferenceVrls = 4000;
     int partReferenceSets = 5;
+    // Chunks per half of part (d)'s reference (at least 8). More than 8: built in a
+    // second stage from the 8-chunk reference (`vrl_report --references`); until
+    // then a report uses the 8-chunk one and says that it is short.
+    int partReferenceChunks = 8;
     std::vector<MethodRun> runs;    // the whole image, then part (d) alone (multipleOnly)
     uint64_t tableLights = 100000;  // N of the Table 1 / Figure 6 runs (both Lightcuts at the default threshold)
     std::vector<uint64_t> speedupLights;  // N of the Figure 4 speed-up measurement

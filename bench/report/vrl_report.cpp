@@ -57,6 +57,7 @@ struct Options {
     fs::path out = "report";
     bool buildReferences = false;  // --references: build the missing references, then stop
     double referenceMinutes = 0.0;  // --references: stop after this long (0: no limit); a later run resumes
+    int partReferenceChunks = 0;  // --part-reference-chunks: every scene's part (d) reference this long (0: the scene's)
     fs::path references = fs::path(VRL_SOURCE_DIR) / "bench" / "references";  // --quick: OUT/cache
     fs::path shared = fs::path(VRL_SOURCE_DIR).parent_path() / "shared" / "scenes";
     bool quick = false;
@@ -112,6 +113,7 @@ struct ReferenceInfo {
     double seconds = 0.0;  // when rendered in this run or recorded in the cache
     bool cached = false;
     bool incomplete = false;  // stopped at the time limit; its chunks so far are kept in a .partial.exr
+    int chunks = 0, wantedChunks = 0;  // per half: stored, and what the scene asks for (more: short)
     double noiseRmse = 0.0, noiseRelativeRmse = 0.0, noiseSmape = 0.0;
     fs::path file;
 };
@@ -242,145 +244,220 @@ std::string gitCommit() {
     return out.empty() ? "unknown" : out;
 }
 
-// Renders (or loads) a reference: the mean of two independent halves, stored in
-// `dir` as half-float EXR (float where a value exceeds half's range) with its
-// halves, keyed by a hash of the scene's files, the settings and the method, and
-// a text file beside it with the settings, the code version and the estimated noise.
-Image referenceImage(const BenchmarkScene& s, const Scene& scene, ReferencePart part, const fs::path& dir,
-                     const Log& log, ReferenceInfo& info, double minutes = 0.0) {
+// What a reference of `chunks` chunks per half is: the key its file is named by
+// (a hash of it and the scene's files), the file, and how it was made. A part (d)
+// reference of more than kReferenceChunks chunks is built in two stages: the
+// kReferenceChunks-chunk reference (its own file, made first), then the chunks
+// after those, continuing its halves' running means as stored; a build from
+// nothing goes through the same two stages and gives the same bits.
+struct ReferenceSpec {
+    int chunks = kReferenceChunks;
+    std::string key, what, method;
+    int spp = 0;  // camera samples per pixel in all (part (d): one per VRL set)
+    int sets = 0;  // part (d): VRL sets in all
+    uint64_t lightPaths = 0;
+    bool lightTraced = false;
+    fs::path file;
+};
+
+ReferenceSpec referenceSpec(const BenchmarkScene& s, ReferencePart part, const fs::path& dir, int chunks) {
     const RenderSettings first = referenceChunk(s, part, 0, 0).front();
     const bool image = part == ReferencePart::Image;
-    const std::string what = image ? "reference" : "part (d) reference";
-    const int chunks = kReferenceChunks;
+    ReferenceSpec spec;
+    spec.chunks = chunks;
+    spec.what = image ? "reference" : "part (d) reference";
     const int perHalf = chunks * first.samplesPerPixel;
-    const int sets = 2 * chunks * s.partReferenceSets;  // part (d): VRL sets in all
-    const bool lightTraced = lightTracedReference(s, part);
-    const uint64_t lightPaths = uint64_t(2 * chunks) * std::max<uint64_t>(1, s.referenceLightPaths / 2 / kReferenceChunks);
+    spec.sets = 2 * chunks * s.partReferenceSets;
+    spec.lightTraced = lightTracedReference(s, part);
+    spec.lightPaths = uint64_t(2 * chunks) * std::max<uint64_t>(1, s.referenceLightPaths / 2 / kReferenceChunks);
     std::string key = image ? "path spp=" + std::to_string(first.samplesPerPixel) + "x" + std::to_string(chunks) + "x2"
                             : "vrl transports=multiple vrls=" + std::to_string(first.vrlCount) + " spp=1 sets=" +
                                   std::to_string(s.partReferenceSets) + "x" + std::to_string(chunks) + "x2";
-    if (lightTraced)
-        key = "light tracing to the camera paths=" + std::to_string(lightPaths) + " footprint=" +
+    if (spec.lightTraced)
+        key = "light tracing to the camera paths=" + std::to_string(spec.lightPaths) + " footprint=" +
               std::to_string(kReferencePixelFootprint) + " path tracer at pixel centres " + key;
     key += " maxDepth=" + std::to_string(s.maxDepth) + " size=" + std::to_string(s.width) + "x" +
            std::to_string(s.height) + " medium=" + s.medium + " version=" + VRL_VERSION;
-    const fs::path file =
-        dir / (s.name + (image ? "-reference-" : "-reference-d-") + hashSceneAndSettings(s, key) + ".exr");
-    info.part = part;
-    info.method = lightTraced ? "light tracing to the camera, " + std::to_string(lightPaths / 1000000) +
-                                    "M light paths over the centred quarter of each pixel's width, plus the path "
-                                    "tracer where the camera sees specular surfaces or "
-                                    "emitters, " + std::to_string(2 * perHalf) + " spp at pixel centres"
-                : image ? "path tracer, " + std::to_string(2 * perHalf) + " spp"
-                        : "plain VRLs over " + std::to_string(sets) + " independent VRL sets of " +
-                              std::to_string(first.vrlCount);
-    info.spp = image ? 2 * perHalf : sets;  // camera samples per pixel in all (part (d): one per set)
-    info.file = file;
-    ImageSet set;
-    if (fs::exists(file)) {
-        set = readExr(file);
-        info.cached = true;
-        info.seconds = metadataNumber(set.metadata["vrl.report.seconds"]);
-        log.line("%s: %s from the cache (%s)", s.name.c_str(), what.c_str(), file.filename().c_str());
-    } else {
-        // Resume from the chunks a stopped run saved.
-        const fs::path partial = fs::path(file).replace_extension(".partial.exr");
-        std::vector<Image> halves(2, Image(s.width, s.height));
-        int done = 0;
-        double seconds = 0.0;
-        if (fs::exists(partial)) {
-            ImageSet saved = readExr(partial);
-            if (std::get<std::string>(saved.metadata["vrl.report.key"]) != key || saved.layers.size() != 2)
-                throw std::runtime_error(partial.string() + " belongs to other settings; delete it");
-            halves = {saved.layers[0].second, saved.layers[1].second};  // half1, half2 (sorted by name)
-            done = std::get<int32_t>(saved.metadata["vrl.report.chunks"]);
-            seconds = metadataNumber(saved.metadata["vrl.report.seconds"]);
-            log.line("%s: %s: resuming after %d of %d chunks", s.name.c_str(), what.c_str(), done, chunks);
-        } else {
-            log.line("%s: rendering the %s, %s in two halves of %d chunks (%dx%d)...", s.name.c_str(), what.c_str(),
-                     info.method.c_str(), chunks, s.width, s.height);
-        }
-        const auto start = Clock::now();
-        while (done < chunks) {
-            for (uint64_t h = 0; h < 2; ++h) {
-                const Image chunk = renderReferenceChunk(s, scene, part, h, done);
-                for (size_t i = 0; i < chunk.pixelCount(); ++i)  // the running mean of the chunks
-                    halves[h][i] = halves[h][i] + (chunk[i] - halves[h][i]) * (1.0f / float(done + 1));
-            }
-            ++done;
-            log.line("%s: %s: chunk %d of %d", s.name.c_str(), what.c_str(), done, chunks);
-            if (done == chunks) break;
-            // Every chunk is kept (written beside, then renamed: a run killed at any
-            // moment loses at most the chunk it was rendering); a later run resumes.
-            ImageSet save;
-            save.image = halves[0];
-            save.layers = {{"half1", halves[0]}, {"half2", halves[1]}};
-            save.metadata["vrl.report.key"] = key;
-            save.metadata["vrl.report.chunks"] = int32_t(done);
-            save.metadata["vrl.report.seconds"] = seconds + secondsSince(start);
-            fs::create_directories(dir);
-            const fs::path writing = fs::path(partial).concat(".writing");
-            writeExr(writing, save);
-            fs::rename(writing, partial);
-            // At the time limit (after at least one chunk, so that every run makes progress): stop.
-            if (minutes > 0.0 && secondsSince(start) > 60.0 * minutes) {
-                log.line("%s: %s stopped at the time limit after %d of %d chunks (kept in %s; run again to go on)",
-                         s.name.c_str(), what.c_str(), done, chunks, partial.filename().c_str());
-                info.incomplete = true;
-                return Image();
-            }
-        }
-        info.seconds = seconds + secondsSince(start);
-        fs::remove(partial);
-        Image mean(s.width, s.height);
-        for (size_t i = 0; i < mean.pixelCount(); ++i) mean[i] = (halves[0][i] + halves[1][i]) * 0.5f;
-        set.image = mean;
-        set.layers = {{"half1", halves[0]}, {"half2", halves[1]}};
-        RenderRecord record;
-        record.scene = s.file.string();
-        record.defines = s.defines;
-        record.medium = s.medium;
-        record.settings = first;
-        record.settings.samplesPerPixel = info.spp;  // the chunks of the two halves together
-        record.statistics.seconds = info.seconds;
-        record.run = {{"halves", int32_t(2)}, {"chunks", int32_t(chunks)}};
-        if (!image) record.run["vrlSets"] = int32_t(sets);
-        if (lightTraced) {
-            record.run["lightPaths"] = double(lightPaths);
-            record.run["estimator"] = std::string("light tracing to the camera");
-        }
-        writeRenderMetadata(record, scene.camera(), set.metadata);
-        set.metadata["vrl.report.key"] = key;
-        set.metadata["vrl.report.seconds"] = info.seconds;
-        set.metadata["vrl.report.commit"] = gitCommit();
-        fs::create_directories(dir);
-        try {
-            writeExr(file, set, ExrPixels::Half);
-        } catch (const std::invalid_argument&) {  // a value beyond half's range
-            writeExr(file, set);
-        }
-        log.line("%s: %s done in %.1f s -> %s", s.name.c_str(), what.c_str(), info.seconds, file.string().c_str());
-    }
-    const Image* h1 = nullptr;
-    const Image* h2 = nullptr;
-    for (const auto& [name, layer] : set.layers) {
-        if (name == "half1") h1 = &layer;
-        if (name == "half2") h2 = &layer;
-    }
-    if (!h1 || !h2) throw std::runtime_error("cached reference " + file.string() + " lacks its halves; delete it");
-    // The mean of two halves has half the variance of one: its RMSE against the
-    // truth is about RMSE(half1, half2) / 2 (independent, equal variance).
-    const ImageErrorMetrics m = compareImages(*h1, *h2);
+    if (chunks > kReferenceChunks) key += " extends chunks=" + std::to_string(kReferenceChunks);
+    spec.key = key;
+    spec.file = dir / (s.name + (image ? "-reference-" : "-reference-d-") + hashSceneAndSettings(s, key) + ".exr");
+    spec.method = spec.lightTraced
+                      ? "light tracing to the camera, " + std::to_string(spec.lightPaths / 1000000) +
+                            "M light paths over the centred quarter of each pixel's width, plus the path "
+                            "tracer where the camera sees specular surfaces or "
+                            "emitters, " + std::to_string(2 * perHalf) + " spp at pixel centres"
+                  : image ? "path tracer, " + std::to_string(2 * perHalf) + " spp"
+                          : "plain VRLs over " + std::to_string(spec.sets) + " independent VRL sets of " +
+                                std::to_string(first.vrlCount);
+    spec.spp = image ? 2 * perHalf : spec.sets;
+    return spec;
+}
+
+const Image& layerNamed(const ImageSet& set, const std::string& name, const fs::path& file) {
+    for (const auto& [layer, image] : set.layers)
+        if (layer == name) return image;
+    throw std::runtime_error("reference " + file.string() + " lacks its layer " + name + "; delete it");
+}
+
+// A reference's noise from its halves, into `info`: the mean of two halves has half
+// the variance of one, so its RMSE against the truth is about RMSE(half1, half2) / 2
+// (independent, equal variance).
+void measureNoise(const ImageSet& set, const fs::path& file, ReferenceInfo& info) {
+    const ImageErrorMetrics m = compareImages(layerNamed(set, "half1", file), layerNamed(set, "half2", file));
     info.noiseRmse = m.rmse / 2.0;
     info.noiseRelativeRmse = m.relativeRmse / 2.0;
     info.noiseSmape = m.smape / 2.0;  // SMAPE is not a variance; halving is only indicative
-    if (!info.cached) {  // the record beside it, for a reader of bench/references/
-        std::ofstream note(fs::path(file).replace_extension(".txt"));
-        note << what << " of " << s.name << "\nfile: " << file.filename().string() << "\nmethod: " << info.method
-             << "\nkey: " << key << "\ncommit: " << gitCommit() << "\nseconds: " << info.seconds
-             << "\nnoise (RMSE of the mean, from the halves): " << info.noiseRmse
-             << "\nnoise relative RMSE: " << info.noiseRelativeRmse << "\n";
+}
+
+// The chunks per half a scene's reference asks for.
+int referenceChunks(const BenchmarkScene& s, ReferencePart part) {
+    return part == ReferencePart::Multiple ? std::max(kReferenceChunks, s.partReferenceChunks) : kReferenceChunks;
+}
+
+// Loads reference `spec` from `dir`, or renders it (resuming from the chunks a
+// stopped run saved in a .partial.exr beside it; one of more than kReferenceChunks
+// chunks from the kReferenceChunks-chunk reference, made first if missing) and
+// stores it as half-float EXR (float where a value exceeds half's range) with its
+// halves and, beside it, a text file with the settings, the code version and the
+// estimated noise. An empty set with info.incomplete: stopped at the time limit.
+ImageSet referenceSet(const BenchmarkScene& s, const Scene& scene, ReferencePart part, const ReferenceSpec& spec,
+                      const fs::path& dir, const Log& log, ReferenceInfo& info, double minutes) {
+    const auto describe = [&] {
+        info.part = part;
+        info.method = spec.method;
+        info.spp = spec.spp;
+        info.file = spec.file;
+        info.chunks = spec.chunks;
+    };
+    describe();
+    ImageSet set;
+    if (fs::exists(spec.file)) {
+        set = readExr(spec.file);
+        info.cached = true;
+        info.seconds = metadataNumber(set.metadata["vrl.report.seconds"]);
+        log.line("%s: %s from the cache (%s)", s.name.c_str(), spec.what.c_str(), spec.file.filename().c_str());
+        return set;
     }
+    const fs::path partial = fs::path(spec.file).replace_extension(".partial.exr");
+    std::vector<Image> halves(2, Image(s.width, s.height));
+    int done = 0;
+    double seconds = 0.0;
+    if (fs::exists(partial)) {  // resume from the chunks a stopped run saved
+        ImageSet saved = readExr(partial);
+        if (std::get<std::string>(saved.metadata["vrl.report.key"]) != spec.key || saved.layers.size() != 2)
+            throw std::runtime_error(partial.string() + " belongs to other settings; delete it");
+        halves = {layerNamed(saved, "half1", partial), layerNamed(saved, "half2", partial)};
+        done = std::get<int32_t>(saved.metadata["vrl.report.chunks"]);
+        seconds = metadataNumber(saved.metadata["vrl.report.seconds"]);
+        log.line("%s: %s: resuming after %d of %d chunks", s.name.c_str(), spec.what.c_str(), done, spec.chunks);
+    } else if (spec.chunks > kReferenceChunks) {  // the second stage: from the first's halves
+        const ReferenceSpec firstStage = referenceSpec(s, part, dir, kReferenceChunks);
+        (void)referenceSet(s, scene, part, firstStage, dir, log, info, minutes);
+        if (info.incomplete) return {};
+        const ImageSet from = readExr(firstStage.file);  // as stored (half floats), however it came to be
+        describe();
+        info.cached = false;
+        halves = {layerNamed(from, "half1", firstStage.file), layerNamed(from, "half2", firstStage.file)};
+        done = kReferenceChunks;
+        seconds = info.seconds;
+        log.line("%s: %s: extending %s from %d to %d chunks per half (%s)", s.name.c_str(), spec.what.c_str(),
+                 firstStage.file.filename().c_str(), done, spec.chunks, spec.method.c_str());
+    } else {
+        log.line("%s: rendering the %s, %s in two halves of %d chunks (%dx%d)...", s.name.c_str(), spec.what.c_str(),
+                 spec.method.c_str(), spec.chunks, s.width, s.height);
+    }
+    const auto start = Clock::now();
+    while (done < spec.chunks) {
+        for (uint64_t h = 0; h < 2; ++h) {
+            const Image chunk = renderReferenceChunk(s, scene, part, h, done);
+            for (size_t i = 0; i < chunk.pixelCount(); ++i)  // the running mean of the chunks
+                halves[h][i] = halves[h][i] + (chunk[i] - halves[h][i]) * (1.0f / float(done + 1));
+        }
+        ++done;
+        log.line("%s: %s: chunk %d of %d", s.name.c_str(), spec.what.c_str(), done, spec.chunks);
+        if (done == spec.chunks) break;
+        // Every chunk is kept (written beside, then renamed: a run killed at any
+        // moment loses at most the chunk it was rendering); a later run resumes.
+        ImageSet save;
+        save.image = halves[0];
+        save.layers = {{"half1", halves[0]}, {"half2", halves[1]}};
+        save.metadata["vrl.report.key"] = spec.key;
+        save.metadata["vrl.report.chunks"] = int32_t(done);
+        save.metadata["vrl.report.seconds"] = seconds + secondsSince(start);
+        fs::create_directories(dir);
+        const fs::path writing = fs::path(partial).concat(".writing");
+        writeExr(writing, save);
+        fs::rename(writing, partial);
+        // At the time limit (after at least one chunk, so that every run makes progress): stop.
+        if (minutes > 0.0 && secondsSince(start) > 60.0 * minutes) {
+            log.line("%s: %s stopped at the time limit after %d of %d chunks (kept in %s; run again to go on)",
+                     s.name.c_str(), spec.what.c_str(), done, spec.chunks, partial.filename().c_str());
+            info.incomplete = true;
+            return {};
+        }
+    }
+    info.seconds = seconds + secondsSince(start);
+    fs::remove(partial);
+    Image mean(s.width, s.height);
+    for (size_t i = 0; i < mean.pixelCount(); ++i) mean[i] = (halves[0][i] + halves[1][i]) * 0.5f;
+    set.image = mean;
+    set.layers = {{"half1", halves[0]}, {"half2", halves[1]}};
+    RenderRecord record;
+    record.scene = s.file.string();
+    record.defines = s.defines;
+    record.medium = s.medium;
+    record.settings = referenceChunk(s, part, 0, 0).front();
+    record.settings.samplesPerPixel = spec.spp;  // the chunks of the two halves together
+    record.statistics.seconds = info.seconds;
+    record.run = {{"halves", int32_t(2)}, {"chunks", int32_t(spec.chunks)}};
+    if (part == ReferencePart::Multiple) record.run["vrlSets"] = int32_t(spec.sets);
+    if (spec.lightTraced) {
+        record.run["lightPaths"] = double(spec.lightPaths);
+        record.run["estimator"] = std::string("light tracing to the camera");
+    }
+    writeRenderMetadata(record, scene.camera(), set.metadata);
+    set.metadata["vrl.report.key"] = spec.key;
+    set.metadata["vrl.report.seconds"] = info.seconds;
+    set.metadata["vrl.report.commit"] = gitCommit();
+    fs::create_directories(dir);
+    try {
+        writeExr(spec.file, set, ExrPixels::Half);
+    } catch (const std::invalid_argument&) {  // a value beyond half's range
+        writeExr(spec.file, set);
+    }
+    log.line("%s: %s done in %.1f s -> %s", s.name.c_str(), spec.what.c_str(), info.seconds, spec.file.string().c_str());
+    // The record beside it, for a reader of bench/references/.
+    measureNoise(set, spec.file, info);
+    std::ofstream note(fs::path(spec.file).replace_extension(".txt"));
+    note << spec.what << " of " << s.name << "\nfile: " << spec.file.filename().string() << "\nmethod: " << spec.method
+         << "\nkey: " << spec.key;
+    if (spec.chunks > kReferenceChunks)
+        note << "\nextends: " << referenceSpec(s, part, dir, kReferenceChunks).file.filename().string() << " (its "
+             << kReferenceChunks << " chunks per half as stored, then chunks " << kReferenceChunks + 1 << "-"
+             << spec.chunks << ")";
+    note << "\ncommit: " << gitCommit() << "\nseconds: " << info.seconds
+         << "\nnoise (RMSE of the mean, from the halves): " << info.noiseRmse
+         << "\nnoise relative RMSE: " << info.noiseRelativeRmse << "\n";
+    return set;
+}
+
+// A scene's reference (the mean of its two halves), loaded or rendered
+// (referenceSet), with its noise in `info`. `extend`: a part (d) reference the
+// scene asks more chunks of than are stored is extended (--references); without
+// it, the stored kReferenceChunks-chunk reference is used and the summary says so
+// (a report run never spends hours on a reference that exists).
+Image referenceImage(const BenchmarkScene& s, const Scene& scene, ReferencePart part, const fs::path& dir,
+                     const Log& log, ReferenceInfo& info, double minutes, bool extend) {
+    const int wanted = referenceChunks(s, part);
+    const bool stored = fs::exists(referenceSpec(s, part, dir, wanted).file);
+    const ReferenceSpec spec = referenceSpec(s, part, dir, extend || stored ? wanted : kReferenceChunks);
+    const ImageSet set = referenceSet(s, scene, part, spec, dir, log, info, minutes);
+    if (info.incomplete) return Image();
+    info.wantedChunks = wanted;
+    if (info.chunks < wanted)
+        log.line("%s: %s has %d of the %d chunks per half the scene asks for (vrl_report --references extends it)",
+                 s.name.c_str(), spec.what.c_str(), info.chunks, wanted);
+    measureNoise(set, spec.file, info);
     return set.image;
 }
 
@@ -903,8 +980,12 @@ void writeSummary(const fs::path& path, const Options& o, const std::vector<Scen
                << fmt(s.reference.noiseRelativeRmse) << " / " << fmt(s.reference.noiseSmape) << " | ";
         else
             md << "none (part (d) alone) | | ";
-        md << s.partReference.method << ", " << fmt(s.partReference.seconds, 4)
-           << " s" << (s.partReference.cached ? " (cached)" : "") << " | " << fmt(s.partReference.noiseRmse) << " / "
+        md << s.partReference.method << ", " << fmt(s.partReference.seconds, 4) << " s"
+           << (s.partReference.cached ? " (cached)" : "");
+        if (s.partReference.wantedChunks > s.partReference.chunks)
+            md << " (short: the scene asks for " << 2 * s.partReference.wantedChunks * s.scene.partReferenceSets
+               << " sets; `vrl_report --references` extends it)";
+        md << " | " << fmt(s.partReference.noiseRmse) << " / "
            << fmt(s.partReference.noiseRelativeRmse) << " / " << fmt(s.partReference.noiseSmape) << " |\n";
     }
     md << "\n";
@@ -986,6 +1067,8 @@ int runReport(const Options& o) {
         std::erase_if(list, [&](const BenchmarkScene& s) { return std::find(o.only.begin(), o.only.end(), s.name) == o.only.end(); });
         if (list.empty()) throw std::invalid_argument("--scenes names no benchmark scene");
     }
+    if (o.partReferenceChunks > 0)
+        for (auto& s : list) s.partReferenceChunks = o.partReferenceChunks;
     log.line("report: %zu scenes, %d threads, output in %s%s", list.size(), threads, o.out.string().c_str(),
              o.quick ? " (quick)" : "");
     std::vector<SceneReport> scenes;
@@ -1014,11 +1097,13 @@ int runReport(const Options& o) {
             const bool wholeImage =
                 std::any_of(s.runs.begin(), s.runs.end(), [](const MethodRun& r) { return !r.multipleOnly; });
             const Image reference =
-                wholeImage ? referenceImage(s, *scene, ReferencePart::Image, referenceDir, log, report.reference, minutes)
+                wholeImage ? referenceImage(s, *scene, ReferencePart::Image, referenceDir, log, report.reference, minutes,
+                                            o.buildReferences)
                            : Image();
             const double left = minutes > 0.0 ? std::max(1e-9, minutes - secondsSince(referenceStart) / 60.0) : 0.0;
             const Image partReference =
-                referenceImage(s, *scene, ReferencePart::Multiple, referenceDir, log, report.partReference, left);
+                referenceImage(s, *scene, ReferencePart::Multiple, referenceDir, log, report.partReference, left,
+                               o.buildReferences);
             if (o.buildReferences) return;
             if (scenes.empty())  // the first scene: the part (d) reference against plain VRLs over independent sets
                 report.partCheck =
@@ -1186,6 +1271,12 @@ int main(int argc, char** argv) {
                    "--references: stop each scene's references after about this many minutes, at least one chunk "
                    "each (0, the default: no limit); the chunks done are kept and a later run resumes them")
         ->check(CLI::NonNegativeNumber);
+    app.add_option("--part-reference-chunks", o.partReferenceChunks,
+                   "Part (d) references of this many chunks per half (a chunk: the scene's VRL sets per chunk, 5 "
+                   "for most, in each half; default: the scene's, 8). More than 8: --references extends the stored "
+                   "8-chunk reference (resumable, like every reference); a report run uses the longer one once it "
+                   "is stored, and the 8-chunk one until then, saying so")
+        ->check(CLI::Range(8, 1000));
     app.add_option("--references-dir", o.references,
                    "Where references are kept and looked up by a hash of scene, settings and method (default "
                    "bench/references in the source tree)");
