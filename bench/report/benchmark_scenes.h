@@ -65,9 +65,18 @@ struct BenchmarkScene {
 };
 
 // The scene list. `repository`: the source tree (for scenes/); `shared`: the
-// shared scene folder (may not exist). No two runs of a scene have the same curve
-// and label (they would be the same render under the same seed).
+// shared scene folder (may not exist). Every scene passes checkScene.
 std::vector<BenchmarkScene> benchmarkScenes(bool quick, const std::filesystem::path& repository,
                                             const std::filesystem::path& shared);
+
+// Throws std::logic_error naming the scene where two runs have the same curve and
+// label (the same render under the same seed) or partReferenceChunks is below 8.
+void checkScene(const BenchmarkScene& s);
+
+// The settings `run` renders with in scene `s` (`seed`: its random streams).
+RenderSettings settingsFor(const BenchmarkScene& s, const MethodRun& run, uint64_t seed);
+// A run of the report: settingsFor with the run's own seed, run.seed(s.name), so
+// the same run renders the same image wherever it stands in the sweep.
+RenderSettings runSettings(const BenchmarkScene& s, const MethodRun& run);
 
 }  // namespace vrl::report

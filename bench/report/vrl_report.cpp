@@ -161,22 +161,10 @@ std::unique_ptr<Scene> loadScene(const BenchmarkScene& s) {
     return Scene::build(description);
 }
 
-RenderSettings settingsFor(const BenchmarkScene& s, const MethodRun& run, uint64_t seed) {
-    RenderSettings settings;
-    settings.method = run.method;
-    settings.samplesPerPixel = run.spp;
-    settings.seed = seed;
-    settings.maxDepth = s.maxDepth;
-    settings.vrlCount = std::max<uint64_t>(1, run.lights);
-    settings.cut.errorThreshold = run.errorThreshold;
-    if (run.cutSize > 0) settings.cut.stochasticCutSize = run.cutSize;
-    if (run.multipleOnly) settings.transports = TransportSelection::parse("multiple");
-    return settings;
-}
-
-// A reference half is rendered in kReferenceChunks chunks, each with its own
-// seeds (so its own random streams and, for part (d), its own VRL sets), saved
-// after each chunk: a long reference can be built over several runs.
+// A reference half is rendered in kReferenceChunks chunks (part (d): at least
+// that many, BenchmarkScene::partReferenceChunks), each with its own seeds (so its
+// own random streams and, for part (d), its own VRL sets), saved after each chunk:
+// a long reference can be built over several runs.
 constexpr int kReferenceChunks = 8;
 
 // The renders of chunk `chunk` of one half of a reference, whose mean is the
@@ -309,6 +297,17 @@ void measureNoise(const ImageSet& set, const fs::path& file, ReferenceInfo& info
     info.noiseSmape = m.smape / 2.0;  // SMAPE is not a variance; halving is only indicative
 }
 
+// SHA-256 of a reference's two halves' pixels (not the file's bytes, whose
+// metadata holds timings): what a second stage was started from.
+std::string halvesDigest(const ImageSet& set, const fs::path& file) {
+    std::string bytes;
+    for (const char* name : {"half1", "half2"}) {
+        const Image& half = layerNamed(set, name, file);
+        bytes.append(reinterpret_cast<const char*>(&half[0]), half.pixelCount() * sizeof(half[0]));
+    }
+    return util::sha256Hex(bytes);
+}
+
 // The chunks per half a scene's reference asks for.
 int referenceChunks(const BenchmarkScene& s, ReferencePart part) {
     return part == ReferencePart::Multiple ? std::max(kReferenceChunks, s.partReferenceChunks) : kReferenceChunks;
@@ -322,6 +321,7 @@ int referenceChunks(const BenchmarkScene& s, ReferencePart part) {
 // estimated noise. An empty set with info.incomplete: stopped at the time limit.
 ImageSet referenceSet(const BenchmarkScene& s, const Scene& scene, ReferencePart part, const ReferenceSpec& spec,
                       const fs::path& dir, const Log& log, ReferenceInfo& info, double minutes) {
+    // `minutes`: the time limit of this call, both stages together (0: none).
     const auto describe = [&] {
         info.part = part;
         info.method = spec.method;
@@ -342,26 +342,44 @@ ImageSet referenceSet(const BenchmarkScene& s, const Scene& scene, ReferencePart
     std::vector<Image> halves(2, Image(s.width, s.height));
     int done = 0;
     double seconds = 0.0;
+    // The second stage: the kReferenceChunks-chunk reference it extends (made first
+    // if missing, within the same time limit), and a digest of its halves, which a
+    // partial of this stage must have been started from.
+    ImageSet from;
+    std::string base;
+    fs::path firstFile;
+    if (spec.chunks > kReferenceChunks) {
+        const ReferenceSpec firstStage = referenceSpec(s, part, dir, kReferenceChunks);
+        firstFile = firstStage.file;
+        if (!fs::exists(firstStage.file))
+            log.line("%s: the %d-chunk %s extends the %d-chunk one: that first", s.name.c_str(), spec.chunks,
+                     spec.what.c_str(), kReferenceChunks);
+        const auto entry = Clock::now();
+        (void)referenceSet(s, scene, part, firstStage, dir, log, info, minutes);
+        if (info.incomplete) return {};
+        if (minutes > 0.0) minutes = std::max(1e-9, minutes - secondsSince(entry) / 60.0);
+        seconds = info.seconds;
+        describe();
+        info.cached = false;
+        from = readExr(firstStage.file);  // as stored (half floats), however it came to be
+        base = halvesDigest(from, firstStage.file);
+    }
     if (fs::exists(partial)) {  // resume from the chunks a stopped run saved
         ImageSet saved = readExr(partial);
         if (std::get<std::string>(saved.metadata["vrl.report.key"]) != spec.key || saved.layers.size() != 2)
             throw std::runtime_error(partial.string() + " belongs to other settings; delete it");
+        if (!base.empty() && metadataText(saved.metadata["vrl.report.extends"]) != base)
+            throw std::runtime_error(partial.string() + " was started from another " + firstFile.filename().string() +
+                                     " than the one stored now; delete it");
         halves = {layerNamed(saved, "half1", partial), layerNamed(saved, "half2", partial)};
         done = std::get<int32_t>(saved.metadata["vrl.report.chunks"]);
         seconds = metadataNumber(saved.metadata["vrl.report.seconds"]);
         log.line("%s: %s: resuming after %d of %d chunks", s.name.c_str(), spec.what.c_str(), done, spec.chunks);
-    } else if (spec.chunks > kReferenceChunks) {  // the second stage: from the first's halves
-        const ReferenceSpec firstStage = referenceSpec(s, part, dir, kReferenceChunks);
-        (void)referenceSet(s, scene, part, firstStage, dir, log, info, minutes);
-        if (info.incomplete) return {};
-        const ImageSet from = readExr(firstStage.file);  // as stored (half floats), however it came to be
-        describe();
-        info.cached = false;
-        halves = {layerNamed(from, "half1", firstStage.file), layerNamed(from, "half2", firstStage.file)};
+    } else if (!base.empty()) {  // the second stage from the first's halves
+        halves = {layerNamed(from, "half1", firstFile), layerNamed(from, "half2", firstFile)};
         done = kReferenceChunks;
-        seconds = info.seconds;
         log.line("%s: %s: extending %s from %d to %d chunks per half (%s)", s.name.c_str(), spec.what.c_str(),
-                 firstStage.file.filename().c_str(), done, spec.chunks, spec.method.c_str());
+                 firstFile.filename().c_str(), done, spec.chunks, spec.method.c_str());
     } else {
         log.line("%s: rendering the %s, %s in two halves of %d chunks (%dx%d)...", s.name.c_str(), spec.what.c_str(),
                  spec.method.c_str(), spec.chunks, s.width, s.height);
@@ -384,6 +402,7 @@ ImageSet referenceSet(const BenchmarkScene& s, const Scene& scene, ReferencePart
         save.metadata["vrl.report.key"] = spec.key;
         save.metadata["vrl.report.chunks"] = int32_t(done);
         save.metadata["vrl.report.seconds"] = seconds + secondsSince(start);
+        if (!base.empty()) save.metadata["vrl.report.extends"] = base;
         fs::create_directories(dir);
         const fs::path writing = fs::path(partial).concat(".writing");
         writeExr(writing, save);
@@ -419,6 +438,7 @@ ImageSet referenceSet(const BenchmarkScene& s, const Scene& scene, ReferencePart
     set.metadata["vrl.report.key"] = spec.key;
     set.metadata["vrl.report.seconds"] = info.seconds;
     set.metadata["vrl.report.commit"] = gitCommit();
+    if (!base.empty()) set.metadata["vrl.report.extends"] = firstFile.filename().string() + " halves sha256 " + base;
     fs::create_directories(dir);
     try {
         writeExr(spec.file, set, ExrPixels::Half);
@@ -431,11 +451,12 @@ ImageSet referenceSet(const BenchmarkScene& s, const Scene& scene, ReferencePart
     std::ofstream note(fs::path(spec.file).replace_extension(".txt"));
     note << spec.what << " of " << s.name << "\nfile: " << spec.file.filename().string() << "\nmethod: " << spec.method
          << "\nkey: " << spec.key;
-    if (spec.chunks > kReferenceChunks)
-        note << "\nextends: " << referenceSpec(s, part, dir, kReferenceChunks).file.filename().string() << " (its "
-             << kReferenceChunks << " chunks per half as stored, then chunks " << kReferenceChunks + 1 << "-"
+    if (!base.empty())
+        note << "\nextends: " << firstFile.filename().string() << " (its " << kReferenceChunks
+             << " chunks per half as stored, halves sha256 " << base << ", then chunks " << kReferenceChunks + 1 << "-"
              << spec.chunks << ")";
     note << "\ncommit: " << gitCommit() << "\nseconds: " << info.seconds
+         << (base.empty() ? "" : " (both stages)")
          << "\nnoise (RMSE of the mean, from the halves): " << info.noiseRmse
          << "\nnoise relative RMSE: " << info.noiseRelativeRmse << "\n";
     return set;
@@ -455,8 +476,9 @@ Image referenceImage(const BenchmarkScene& s, const Scene& scene, ReferencePart 
     if (info.incomplete) return Image();
     info.wantedChunks = wanted;
     if (info.chunks < wanted)
-        log.line("%s: %s has %d of the %d chunks per half the scene asks for (vrl_report --references extends it)",
-                 s.name.c_str(), spec.what.c_str(), info.chunks, wanted);
+        log.line("%s: %s has %d of the %d chunks per half asked for (vrl_report --references --scenes %s "
+                 "--part-reference-chunks %d extends it)",
+                 s.name.c_str(), spec.what.c_str(), info.chunks, wanted, s.name.c_str(), wanted);
     measureNoise(set, spec.file, info);
     return set.image;
 }
@@ -946,7 +968,13 @@ void writeSummary(const fs::path& path, const Options& o, const std::vector<Scen
     std::strftime(date, sizeof date, "%Y-%m-%d %H:%M UTC", std::gmtime(&now));
     md << "# Error against run time: VRL Lightcuts, stochastic VRL Lightcuts, plain VRLs, VPL Lightcuts and path "
           "tracing\n\n";
-    md << "Generated by `build/bench/vrl_report" << (o.quick ? " --quick" : "") << "` on " << date << " with " << threads
+    std::string options = o.quick ? " --quick" : "";
+    if (!o.only.empty()) {
+        options += " --scenes ";
+        for (size_t i = 0; i < o.only.size(); ++i) options += (i ? "," : "") + o.only[i];
+    }
+    if (o.partReferenceChunks > 0) options += " --part-reference-chunks " + std::to_string(o.partReferenceChunks);
+    md << "Generated by `build/bench/vrl_report" << options << "` on " << date << " with " << threads
        << " threads, vrlcuts " << VRL_VERSION << "; the whole report took " << fmt(totalSeconds / 60.0, 3)
        << " minutes. Data: `results.csv`, `speedup.csv`.\n\n";
     md << "Every image is compared with its reference: the whole image with the path tracer's (on a scene lit "
@@ -983,8 +1011,9 @@ void writeSummary(const fs::path& path, const Options& o, const std::vector<Scen
         md << s.partReference.method << ", " << fmt(s.partReference.seconds, 4) << " s"
            << (s.partReference.cached ? " (cached)" : "");
         if (s.partReference.wantedChunks > s.partReference.chunks)
-            md << " (short: the scene asks for " << 2 * s.partReference.wantedChunks * s.scene.partReferenceSets
-               << " sets; `vrl_report --references` extends it)";
+            md << " (short: " << 2 * s.partReference.wantedChunks * s.scene.partReferenceSets
+               << " sets are asked for; `vrl_report --references --scenes " << s.scene.name
+               << " --part-reference-chunks " << s.partReference.wantedChunks << "` extends it)";
         md << " | " << fmt(s.partReference.noiseRmse) << " / "
            << fmt(s.partReference.noiseRelativeRmse) << " / " << fmt(s.partReference.noiseSmape) << " |\n";
     }
@@ -1120,7 +1149,7 @@ int runReport(const Options& o) {
             std::map<std::string, std::string> lastLabel;
             for (const auto& run : s.runs) {
                 ++done;
-                const RenderSettings settings = settingsFor(s, run, run.seed(s.name));
+                const RenderSettings settings = runSettings(s, run);
                 RenderStatistics stats;
                 const auto runStart = Clock::now();
                 ImageSet images = render(*scene, settings, {}, &stats);

@@ -4,7 +4,9 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <set>
+#include <stdexcept>
 
 using namespace vrl;
 using namespace vrl::report;
@@ -31,15 +33,26 @@ TEST(BenchmarkScenes, EveryRunOfEveryListHasItsOwnSeed) {
     }
 }
 
-TEST(BenchmarkScenes, ASeedDependsOnTheRunAndSceneNotOnItsPlace) {
+TEST(BenchmarkScenes, ARunRendersWithTheSameSettingsWhereverItStandsInTheSweep) {
     const auto list = scenes(false);
     const BenchmarkScene& bathroom = list.front();
     ASSERT_GE(bathroom.runs.size(), 3u);
-    const MethodRun& last = bathroom.runs.back();
-    // The same run (same curve and label) in a shorter sweep keeps its seed...
-    std::vector<MethodRun> shorter(bathroom.runs.begin() + 1, bathroom.runs.end());
-    EXPECT_EQ(shorter.back().seed(bathroom.name), last.seed(bathroom.name));
-    // ...and changes it with the scene, the curve or the label.
+    const MethodRun last = bathroom.runs.back();
+    const RenderSettings inFull = runSettings(bathroom, last);
+    EXPECT_EQ(inFull.seed, last.seed(bathroom.name));
+    // The same run in a sweep with runs removed before it and in reverse order.
+    BenchmarkScene shorter = bathroom;
+    shorter.runs.erase(shorter.runs.begin(), shorter.runs.begin() + 2);
+    std::reverse(shorter.runs.begin(), shorter.runs.end());
+    EXPECT_EQ(runSettings(shorter, shorter.runs.front()).seed, inFull.seed);
+    // Every run of every scene: its own seed, from its scene, curve and label.
+    std::set<uint64_t> seeds;
+    for (const BenchmarkScene& s : list)
+        for (const MethodRun& r : s.runs) seeds.insert(runSettings(s, r).seed);
+    size_t runs = 0;
+    for (const BenchmarkScene& s : list) runs += s.runs.size();
+    EXPECT_EQ(seeds.size(), runs);
+    // The seed changes with the scene, the curve or the label.
     EXPECT_NE(last.seed("another scene"), last.seed(bathroom.name));
     MethodRun otherCurve = last;
     otherCurve.multipleOnly = !otherCurve.multipleOnly;
@@ -47,6 +60,17 @@ TEST(BenchmarkScenes, ASeedDependsOnTheRunAndSceneNotOnItsPlace) {
     MethodRun otherLabel = last;
     otherLabel.spp += 1;
     EXPECT_NE(otherLabel.seed(bathroom.name), last.seed(bathroom.name));
+}
+
+TEST(BenchmarkScenes, AListWithARunTwiceOrAShortFirstStageIsRefused) {
+    BenchmarkScene s = scenes(true).front();
+    EXPECT_NO_THROW(checkScene(s));
+    BenchmarkScene twice = s;
+    twice.runs.push_back(twice.runs[1]);
+    EXPECT_THROW(checkScene(twice), std::logic_error);
+    BenchmarkScene shortReference = s;
+    shortReference.partReferenceChunks = 7;
+    EXPECT_THROW(checkScene(shortReference), std::logic_error);
 }
 
 TEST(BenchmarkScenes, ASeedIsTheFirst64BitsOfTheSha256OfSceneCurveAndLabel) {
