@@ -137,9 +137,10 @@ void checkScene(const BenchmarkScene& s) {
     for (const MethodRun& r : s.runs)
         if (!seen.emplace(r.curve(), r.label()).second)
             throw std::logic_error("benchmark scene " + s.name + " runs " + r.curve() + " " + r.label() + " twice");
-    if (s.partReferenceChunks < 8)
+    if (s.partReferenceChunks < kReferenceChunks)
         throw std::logic_error("benchmark scene " + s.name + ": partReferenceChunks " +
-                               std::to_string(s.partReferenceChunks) + " is below 8 (the first stage's)");
+                               std::to_string(s.partReferenceChunks) + " is below " +
+                               std::to_string(kReferenceChunks) + " (the first stage's)");
 }
 
 RenderSettings settingsFor(const BenchmarkScene& s, const MethodRun& run, uint64_t seed) {

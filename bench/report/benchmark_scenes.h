@@ -13,6 +13,12 @@
 
 namespace vrl::report {
 
+// A reference half is rendered in kReferenceChunks chunks (part (d): at least
+// that many, BenchmarkScene::partReferenceChunks), each with its own seeds (so its
+// own random streams and, for part (d), its own VRL sets), saved after each chunk:
+// a long reference can be built over several runs.
+constexpr int kReferenceChunks = 8;
+
 // One render of the sweep. `lights`: VRLs or VPLs (0 for the path tracer);
 // `spp`: samples per pixel (path tracer; parts (a)-(c) of the virtual-light
 // methods; for stochastic VRL Lightcuts also parts (c) and (d): each sample
@@ -55,10 +61,10 @@ struct BenchmarkScene {
     // for the same noise, 2x less time than stochastic VRL Lightcuts over sets).
     uint64_t partReferenceVrls = 4000;
     int partReferenceSets = 5;
-    // Chunks per half of part (d)'s reference (at least 8). More than 8: built in a
-    // second stage from the 8-chunk reference (`vrl_report --references`); until
+    // Chunks per half of part (d)'s reference (at least kReferenceChunks). More: built
+    // in a second stage from the kReferenceChunks-chunk reference (`vrl_report --references`); until
     // then a report uses the 8-chunk one and says that it is short.
-    int partReferenceChunks = 8;
+    int partReferenceChunks = kReferenceChunks;
     std::vector<MethodRun> runs;    // the whole image, then part (d) alone (multipleOnly)
     uint64_t tableLights = 100000;  // N of the Table 1 / Figure 6 runs (both Lightcuts at the default threshold)
     std::vector<uint64_t> speedupLights;  // N of the Figure 4 speed-up measurement
@@ -70,7 +76,8 @@ std::vector<BenchmarkScene> benchmarkScenes(bool quick, const std::filesystem::p
                                             const std::filesystem::path& shared);
 
 // Throws std::logic_error naming the scene where two runs have the same curve and
-// label (the same render under the same seed) or partReferenceChunks is below 8.
+// label (the same render under the same seed) or partReferenceChunks is below
+// kReferenceChunks.
 void checkScene(const BenchmarkScene& s);
 
 // The settings `run` renders with in scene `s` (`seed`: its random streams).

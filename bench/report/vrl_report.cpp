@@ -161,12 +161,6 @@ std::unique_ptr<Scene> loadScene(const BenchmarkScene& s) {
     return Scene::build(description);
 }
 
-// A reference half is rendered in kReferenceChunks chunks (part (d): at least
-// that many, BenchmarkScene::partReferenceChunks), each with its own seeds (so its
-// own random streams and, for part (d), its own VRL sets), saved after each chunk:
-// a long reference can be built over several runs.
-constexpr int kReferenceChunks = 8;
-
 // The renders of chunk `chunk` of one half of a reference, whose mean is the
 // chunk: the path tracer's one render, or part (d)'s one per VRL set (plain
 // VRLs, each set traced from its own seed, so the mean converges to the true
@@ -308,6 +302,11 @@ std::string halvesDigest(const ImageSet& set, const fs::path& file) {
     return util::sha256Hex(bytes);
 }
 
+// The command that extends scene `scene`'s part (d) reference to `chunks` chunks per half.
+std::string extendCommand(const std::string& scene, int chunks) {
+    return "vrl_report --references --scenes " + scene + " --part-reference-chunks " + std::to_string(chunks);
+}
+
 // The chunks per half a scene's reference asks for.
 int referenceChunks(const BenchmarkScene& s, ReferencePart part) {
     return part == ReferencePart::Multiple ? std::max(kReferenceChunks, s.partReferenceChunks) : kReferenceChunks;
@@ -318,7 +317,8 @@ int referenceChunks(const BenchmarkScene& s, ReferencePart part) {
 // chunks from the kReferenceChunks-chunk reference, made first if missing) and
 // stores it as half-float EXR (float where a value exceeds half's range) with its
 // halves and, beside it, a text file with the settings, the code version and the
-// estimated noise. An empty set with info.incomplete: stopped at the time limit.
+// estimated noise (also in `info`). An empty set with info.incomplete: stopped at
+// the time limit.
 ImageSet referenceSet(const BenchmarkScene& s, const Scene& scene, ReferencePart part, const ReferenceSpec& spec,
                       const fs::path& dir, const Log& log, ReferenceInfo& info, double minutes) {
     // `minutes`: the time limit of this call, both stages together (0: none).
@@ -336,6 +336,7 @@ ImageSet referenceSet(const BenchmarkScene& s, const Scene& scene, ReferencePart
         info.cached = true;
         info.seconds = metadataNumber(set.metadata["vrl.report.seconds"]);
         log.line("%s: %s from the cache (%s)", s.name.c_str(), spec.what.c_str(), spec.file.filename().c_str());
+        measureNoise(set, spec.file, info);
         return set;
     }
     const fs::path partial = fs::path(spec.file).replace_extension(".partial.exr");
@@ -463,23 +464,22 @@ ImageSet referenceSet(const BenchmarkScene& s, const Scene& scene, ReferencePart
 }
 
 // A scene's reference (the mean of its two halves), loaded or rendered
-// (referenceSet), with its noise in `info`. `extend`: a part (d) reference the
+// (referenceSet, which puts its noise in `info`). `extend`: a part (d) reference the
 // scene asks more chunks of than are stored is extended (--references); without
 // it, the stored kReferenceChunks-chunk reference is used and the summary says so
 // (a report run never spends hours on a reference that exists).
 Image referenceImage(const BenchmarkScene& s, const Scene& scene, ReferencePart part, const fs::path& dir,
                      const Log& log, ReferenceInfo& info, double minutes, bool extend) {
     const int wanted = referenceChunks(s, part);
-    const bool stored = fs::exists(referenceSpec(s, part, dir, wanted).file);
-    const ReferenceSpec spec = referenceSpec(s, part, dir, extend || stored ? wanted : kReferenceChunks);
+    ReferenceSpec spec = referenceSpec(s, part, dir, wanted);
+    if (!extend && wanted > kReferenceChunks && !fs::exists(spec.file))
+        spec = referenceSpec(s, part, dir, kReferenceChunks);
     const ImageSet set = referenceSet(s, scene, part, spec, dir, log, info, minutes);
     if (info.incomplete) return Image();
     info.wantedChunks = wanted;
     if (info.chunks < wanted)
-        log.line("%s: %s has %d of the %d chunks per half asked for (vrl_report --references --scenes %s "
-                 "--part-reference-chunks %d extends it)",
-                 s.name.c_str(), spec.what.c_str(), info.chunks, wanted, s.name.c_str(), wanted);
-    measureNoise(set, spec.file, info);
+        log.line("%s: %s has %d of the %d chunks per half asked for (%s extends it)", s.name.c_str(),
+                 spec.what.c_str(), info.chunks, wanted, extendCommand(s.name, wanted).c_str());
     return set.image;
 }
 
@@ -1012,8 +1012,8 @@ void writeSummary(const fs::path& path, const Options& o, const std::vector<Scen
            << (s.partReference.cached ? " (cached)" : "");
         if (s.partReference.wantedChunks > s.partReference.chunks)
             md << " (short: " << 2 * s.partReference.wantedChunks * s.scene.partReferenceSets
-               << " sets are asked for; `vrl_report --references --scenes " << s.scene.name
-               << " --part-reference-chunks " << s.partReference.wantedChunks << "` extends it)";
+               << " sets are asked for; `" << extendCommand(s.scene.name, s.partReference.wantedChunks)
+               << "` extends it)";
         md << " | " << fmt(s.partReference.noiseRmse) << " / "
            << fmt(s.partReference.noiseRelativeRmse) << " / " << fmt(s.partReference.noiseSmape) << " |\n";
     }
@@ -1305,7 +1305,7 @@ int main(int argc, char** argv) {
                    "for most, in each half; default: the scene's, 8). More than 8: --references extends the stored "
                    "8-chunk reference (resumable, like every reference); a report run uses the longer one once it "
                    "is stored, and the 8-chunk one until then, saying so")
-        ->check(CLI::Range(8, 1000));
+        ->check(CLI::Range(kReferenceChunks, 1000));
     app.add_option("--references-dir", o.references,
                    "Where references are kept and looked up by a hash of scene, settings and method (default "
                    "bench/references in the source tree)");
