@@ -30,6 +30,7 @@ RESULTS_COLUMNS = [
     "scene", "method", "setting", "vrls", "spp", "error_threshold",
     "seconds", "rmse", "rel_rmse", "smape", "mean_eval", "mean_inter",
     "mean_cut", "mean_ratio", "cut_size", "ref_noise_rmse", "below_noise",
+    "part", "renders", "rmse_min", "rmse_max",
 ]
 SPEEDUP_COLUMNS = [
     "scene", "kind", "n", "brute_seconds_per_pixel",
@@ -271,6 +272,19 @@ def plot_scene(plt, scene, rows, out_dir):
             (line,) = ax.plot(xs, ys, color=colour, marker=marker,
                               linestyle=style, linewidth=1.5, markersize=5,
                               label=text)
+            if column == "rmse":
+                # A point of several renders: the range of their RMSEs (its
+                # marker is their root-mean-square).
+                for row in group:
+                    x = to_float(row["seconds"])
+                    low = to_float(row.get("rmse_min"))
+                    high = to_float(row.get("rmse_max"))
+                    renders = to_float(row.get("renders"))
+                    if (renders is not None and renders > 1
+                            and positive_finite(x) and positive_finite(low)
+                            and positive_finite(high) and high > low):
+                        ax.plot([x, x], [low, high], color=colour,
+                                linewidth=1.0, alpha=0.8)
             drawn += 1
             if text not in labels:
                 labels.append(text)

@@ -30,13 +30,21 @@ struct MethodRun {
     float errorThreshold = 0.02f;
     uint32_t cutSize = 0;
     bool multipleOnly = false;  // part (d) alone (the paper's Figure 3 comparison), against the (d) reference
+    // Renders of this point, each from its own seed: the point's error is their
+    // root-mean-square RMSE (an estimate of the expected MSE, what falls as 1/time
+    // for an unbiased method) and its time their mean. More than one for the
+    // cheapest points, where one render's error moves most with the seed and a
+    // repeat costs least.
+    int repeats = 1;
     std::string label() const;  // no commas (a CSV field)
     // The curve the run belongs to: method, and threshold or cut size where a method has several.
     std::string curve() const;
     // The run's seed in scene `scene`: a hash of the scene's name, the curve and the
     // label, so that every run has its own random streams (no two share the noise of
     // parts (a)-(c)) and keeps them when runs are added to or removed from the sweep.
-    uint64_t seed(const std::string& scene) const;
+    // Render `repeat` (0 to repeats - 1) of the point: repeat 0 has that hash, the
+    // others hash "\nrepeat k" after it too.
+    uint64_t seed(const std::string& scene, int repeat = 0) const;
 };
 
 struct BenchmarkScene {
@@ -76,14 +84,15 @@ std::vector<BenchmarkScene> benchmarkScenes(bool quick, const std::filesystem::p
                                             const std::filesystem::path& shared);
 
 // Throws std::logic_error naming the scene where two runs have the same curve and
-// label (the same render under the same seed) or partReferenceChunks is below
-// kReferenceChunks.
+// label (the same render under the same seed), a run has fewer than one render, or
+// partReferenceChunks is below kReferenceChunks.
 void checkScene(const BenchmarkScene& s);
 
 // The settings `run` renders with in scene `s` (`seed`: its random streams).
 RenderSettings settingsFor(const BenchmarkScene& s, const MethodRun& run, uint64_t seed);
-// A run of the report: settingsFor with the run's own seed, run.seed(s.name), so
-// the same run renders the same image wherever it stands in the sweep.
-RenderSettings runSettings(const BenchmarkScene& s, const MethodRun& run);
+// Render `repeat` of a run of the report: settingsFor with the run's own seed,
+// run.seed(s.name, repeat), so the same run renders the same images wherever it
+// stands in the sweep.
+RenderSettings runSettings(const BenchmarkScene& s, const MethodRun& run, int repeat = 0);
 
 }  // namespace vrl::report

@@ -72,6 +72,11 @@ struct Options {
 // left out of every ratio.
 constexpr double kNoiseFactor = 3.0;
 
+// One point of a curve: run.repeats renders, each from its own seed. `seconds`:
+// their mean time; `metrics`: their root-mean-square RMSE and relative RMSE (the
+// expected squared error is what an unbiased method's time buys down, as 1/time),
+// mean SMAPE and mean luminances, summed pixel counts; rmseMin, rmseMax: the
+// spread of their RMSEs; `stats`: the first render's cut statistics.
 struct RunResult {
     std::string scene;
     MethodRun run;
@@ -79,8 +84,36 @@ struct RunResult {
     ImageErrorMetrics metrics;
     RenderStatistics stats;
     double referenceNoiseRmse = 0.0;
+    int renders = 1;
+    double rmseMin = 0.0, rmseMax = 0.0;
     bool belowNoise() const { return metrics.rmse < kNoiseFactor * referenceNoiseRmse; }
 };
+
+// The point of `renders` (each one render's time and metrics against the same reference).
+void combineRenders(RunResult& r, const std::vector<std::pair<double, ImageErrorMetrics>>& renders) {
+    const double n = double(renders.size());
+    double seconds = 0.0, squared = 0.0, relativeSquared = 0.0, smape = 0.0, meanReference = 0.0, meanTest = 0.0;
+    ImageErrorMetrics m;
+    r.rmseMin = INFINITY, r.rmseMax = -INFINITY;
+    for (const auto& [time, e] : renders) {
+        seconds += time;
+        squared += e.rmse * e.rmse;
+        relativeSquared += e.relativeRmse * e.relativeRmse;
+        smape += e.smape;
+        meanReference += e.meanReference;
+        meanTest += e.meanTest;
+        m.pixels += e.pixels;
+        m.nonFinitePixels += e.nonFinitePixels;
+        r.rmseMin = std::min(r.rmseMin, e.rmse);  // NaN (no pixel compared) stays out of both ends
+        r.rmseMax = std::max(r.rmseMax, e.rmse);
+    }
+    m.rmse = std::sqrt(squared / n);
+    m.relativeRmse = std::sqrt(relativeSquared / n);
+    m.smape = smape / n, m.meanReference = meanReference / n, m.meanTest = meanTest / n;
+    r.seconds = seconds / n;
+    r.metrics = m;
+    r.renders = int(renders.size());
+}
 
 struct SpeedupResult {
     std::string scene, kind;  // kind: VRL, VPL (deterministic cuts) or VRL-stochastic
@@ -800,7 +833,7 @@ void writeComparison(std::ostream& md, const std::vector<RunResult>& results, co
     const std::string recommended = prefix + "vrl-lightcuts e=0.02";
     md << "![error against time](error-time-" << safeName(name) << (multipleOnly ? "-d" : "") << ".png)\n\n";
     md << "| method | settings | time (s) | RMSE | RMSE / reference noise | rel. RMSE | SMAPE | mean ratio | #Eval | #Inter "
-          "|\n|---|---|---|---|---|---|---|---|---|---|\n";
+          "| renders: RMSE from, to |\n|---|---|---|---|---|---|---|---|---|---|---|\n";
     for (const auto& r : results) {
         if (r.scene != name || r.run.multipleOnly != multipleOnly) continue;
         const bool cuts = usesLightTree(r.run.method);
@@ -809,6 +842,8 @@ void writeComparison(std::ostream& md, const std::vector<RunResult>& results, co
            << " | " << fmt(r.metrics.relativeRmse) << " | " << fmt(r.metrics.smape) << " | "
            << fmt(r.metrics.meanReference > 0 ? r.metrics.meanTest / r.metrics.meanReference : NAN) << " | "
            << (cuts ? fmt(r.stats.meanEvaluated, 4) : "") << " | " << (cuts ? fmt(r.stats.meanIntersected, 4) : "")
+           << " | "
+           << (r.renders > 1 ? std::to_string(r.renders) + ": " + fmt(r.rmseMin) + ", " + fmt(r.rmseMax) : "1")
            << " |\n";
     }
     // The noise rule, said in words where it decides the comparison: a reference too
@@ -992,7 +1027,13 @@ void writeSummary(const fs::path& path, const Options& o, const std::vector<Scen
           "pixel centres; maximum path length 12.\n\n"
           "**Noise rule.** A run whose RMSE is below " << fmt(kNoiseFactor) << "× the reference's own estimated RMSE "
           "cannot be told from the reference's noise: it is marked ‡ in the tables, written with below_noise = 1 in "
-          "`results.csv`, and left out of every ratio (its curve then ends before it).\n\n";
+          "`results.csv`, and left out of every ratio (its curve then ends before it).\n\n"
+          "**Points of several renders.** One render's error moves with its seed, most at the cheapest settings, "
+          "so those are rendered more than once, each render from its own seed (the renders column says how many "
+          "and the range of their RMSEs; `results.csv`: renders, rmse_min, rmse_max). Such a point's time is the "
+          "renders' mean, its RMSE and relative RMSE their root-mean-square (the expected squared error, which an "
+          "unbiased method's time buys down), its SMAPE their mean; the images and cut statistics are the first "
+          "render's.\n\n";
     md << "## Scenes\n\n| scene | description | resolution | reference (whole image) | its noise RMSE / rel. RMSE / "
           "SMAPE | part (d) reference | its noise RMSE / rel. RMSE / SMAPE |\n|---|---|---|---|---|---|---|\n";
     for (const auto& s : scenes) {
@@ -1149,16 +1190,29 @@ int runReport(const Options& o) {
             std::map<std::string, std::string> lastLabel;
             for (const auto& run : s.runs) {
                 ++done;
-                const RenderSettings settings = runSettings(s, run);
+                // The point's renders, each from its own seed; the first one's image and
+                // statistics are what the previews and Table 1 show.
+                const Image& against = run.multipleOnly ? partReference : reference;
                 RenderStatistics stats;
-                const auto runStart = Clock::now();
-                ImageSet images = render(*scene, settings, {}, &stats);
-                RunResult r{s.name, run, secondsSince(runStart),
-                            compareImages(run.multipleOnly ? partReference : reference, images.image), stats,
+                ImageSet images;
+                std::vector<std::pair<double, ImageErrorMetrics>> renders;
+                for (int repeat = 0; repeat < run.repeats; ++repeat) {
+                    RenderStatistics repeatStats;
+                    const auto runStart = Clock::now();
+                    ImageSet repeatImages = render(*scene, runSettings(s, run, repeat), {}, &repeatStats);
+                    renders.emplace_back(secondsSince(runStart), compareImages(against, repeatImages.image));
+                    if (repeat == 0) images = std::move(repeatImages), stats = repeatStats;
+                }
+                RunResult r{s.name, run, 0.0, {}, stats,
                             run.multipleOnly ? report.partReference.noiseRmse : report.reference.noiseRmse};
-                log.line("%s (%zu/%zu): %-13s %-22s %8.2f s  RMSE %.4g  rel %.4g  SMAPE %.4g%s%s", s.name.c_str(), done,
-                         totalRuns, std::string(methodName(run.method)).c_str(), run.label().c_str(), r.seconds, r.metrics.rmse,
-                         r.metrics.relativeRmse, r.metrics.smape, r.belowNoise() ? "  (below the reference's noise)" : "",
+                combineRenders(r, renders);
+                const std::string spread = r.renders > 1 ? " (" + std::to_string(r.renders) + " renders, RMSE " +
+                                                               fmt(r.rmseMin, 4) + " to " + fmt(r.rmseMax, 4) + ")"
+                                                         : std::string();
+                log.line("%s (%zu/%zu): %-13s %-22s %8.2f s  RMSE %.4g  rel %.4g  SMAPE %.4g%s%s%s", s.name.c_str(),
+                         done, totalRuns, std::string(methodName(run.method)).c_str(), run.label().c_str(), r.seconds,
+                         r.metrics.rmse, r.metrics.relativeRmse, r.metrics.smape, spread.c_str(),
+                         r.belowNoise() ? "  (below the reference's noise)" : "",
                          r.metrics.nonFinitePixels ? "  (NON-FINITE PIXELS)" : "");
                 // Table 1 and Figure 6: part (d)'s cuts from the (d)-alone runs, part (c)'s
                 // from the whole image's, both Lightcuts at the default threshold and N.
@@ -1244,7 +1298,7 @@ int runReport(const Options& o) {
         // Write what we have after every scene: a long report interrupted keeps its data.
         std::ofstream csv(o.out / "results.csv");
         csv << "scene,method,setting,vrls,spp,error_threshold,seconds,rmse,rel_rmse,smape,mean_eval,mean_inter,mean_cut,"
-               "mean_ratio,cut_size,ref_noise_rmse,below_noise,part\n";
+               "mean_ratio,cut_size,ref_noise_rmse,below_noise,part,renders,rmse_min,rmse_max\n";
         csv << std::setprecision(6);
         for (const auto& r : results)
             csv << r.scene << "," << methodName(r.run.method) << "," << r.run.label() << "," << r.run.lights << "," << r.run.spp << ","
@@ -1253,7 +1307,8 @@ int runReport(const Options& o) {
                 << r.stats.meanCutSize << ","
                 << (r.metrics.meanReference > 0 ? r.metrics.meanTest / r.metrics.meanReference : 0.0) << ","
                 << r.run.cutSize << "," << r.referenceNoiseRmse << "," << (r.belowNoise() ? 1 : 0) << ","
-                << (r.run.multipleOnly ? "multiple" : "image") << "\n";
+                << (r.run.multipleOnly ? "multiple" : "image") << "," << r.renders << "," << r.rmseMin << ","
+                << r.rmseMax << "\n";
         std::ofstream sp(o.out / "speedup.csv");
         sp << "scene,kind,n,brute_seconds_per_pixel,lightcuts_seconds_per_pixel,speedup,mean_eval,mean_inter,"
               "rel_rmse\n";

@@ -1,5 +1,5 @@
-// The benchmark report's scene list: every run's seed is its own and does not
-// depend on where the run stands in the sweep.
+// The benchmark report's scene list: every render's seed is its own and does not
+// depend on where the run stands in the sweep; the cheapest points have several renders.
 #include "bench/report/benchmark_scenes.h"
 
 #include <gtest/gtest.h>
@@ -18,19 +18,41 @@ std::vector<BenchmarkScene> scenes(bool quick) { return benchmarkScenes(quick, "
 
 }  // namespace
 
-TEST(BenchmarkScenes, EveryRunOfEveryListHasItsOwnSeed) {
+TEST(BenchmarkScenes, EveryRenderOfEveryListHasItsOwnSeed) {
     for (const bool quick : {true, false}) {
         const auto list = scenes(quick);
         ASSERT_GE(list.size(), quick ? 2u : 5u);
         std::set<uint64_t> seeds;
-        size_t runs = 0;
+        size_t renders = 0, repeated = 0;
         for (const BenchmarkScene& s : list)
             for (const MethodRun& r : s.runs) {
-                seeds.insert(r.seed(s.name));
-                ++runs;
+                EXPECT_EQ(r.seed(s.name, 0), r.seed(s.name));
+                for (int repeat = 0; repeat < r.repeats; ++repeat) {
+                    seeds.insert(runSettings(s, r, repeat).seed);
+                    ++renders;
+                }
+                repeated += r.repeats > 1;
             }
-        EXPECT_EQ(seeds.size(), runs) << (quick ? "--quick" : "full");
+        EXPECT_EQ(seeds.size(), renders) << (quick ? "--quick" : "full");
+        EXPECT_GE(repeated, 1u) << (quick ? "--quick" : "full") << ": no point of several renders";
     }
+}
+
+TEST(BenchmarkScenes, TheFullReportRendersItsCheapestPointsThreeTimes) {
+    // The points under 3.5 s a render (bathroom, previous report), which cost 1.6 min
+    // a repeat: 53 of them in five scenes, three renders each.
+    size_t repeated = 0;
+    for (const BenchmarkScene& s : scenes(false))
+        for (const MethodRun& r : s.runs) {
+            EXPECT_TRUE(r.repeats == 1 || r.repeats == 3) << s.name << " " << r.curve() << " " << r.label();
+            if (r.repeats == 1) continue;
+            ++repeated;
+            // Cheap: one sample per pixel or few VRLs, never the end of a curve.
+            EXPECT_TRUE(r.spp == 1 || r.lights <= 1000 || r.method == RenderMethod::VrlStochastic)
+                << s.name << " " << r.curve() << " " << r.label();
+            EXPECT_LE(r.spp, 32) << s.name << " " << r.curve() << " " << r.label();
+        }
+    EXPECT_EQ(repeated, 53u);
 }
 
 TEST(BenchmarkScenes, ARunRendersWithTheSameSettingsWhereverItStandsInTheSweep) {
@@ -71,6 +93,9 @@ TEST(BenchmarkScenes, AListWithARunTwiceOrAShortFirstStageIsRefused) {
     BenchmarkScene shortReference = s;
     shortReference.partReferenceChunks = 7;
     EXPECT_THROW(checkScene(shortReference), std::logic_error);
+    BenchmarkScene noRender = s;
+    noRender.runs[0].repeats = 0;
+    EXPECT_THROW(checkScene(noRender), std::logic_error);
 }
 
 TEST(BenchmarkScenes, ASeedIsTheFirst64BitsOfTheSha256OfSceneCurveAndLabel) {
@@ -83,4 +108,6 @@ TEST(BenchmarkScenes, ASeedIsTheFirst64BitsOfTheSha256OfSceneCurveAndLabel) {
     ASSERT_EQ(run.curve(), "path");
     ASSERT_EQ(run.label(), "4 spp");
     EXPECT_EQ(run.seed("bathroom"), 16721067455369837397ull);
+    // A point's second render: int(hashlib.sha256(b"bathroom\npath\n4 spp\nrepeat 1").hexdigest()[:16], 16).
+    EXPECT_EQ(run.seed("bathroom", 1), 1214562105443344340ull);
 }

@@ -29,19 +29,30 @@ head -1 "$out/results.csv" | grep -q '^scene,method,setting,vrls,spp,error_thres
 for m in path vrl vrl-lightcuts vrl-stochastic vpl-lightcuts; do
     grep -q "^bathroom,$m," "$out/results.csv" || fail "no $m row in results.csv"
 done
-# Every row has 18 fields and finite, non-negative errors.
-awk -F, 'NR > 1 { if (NF != 18) { print "bad field count: " $0; exit 1 }
+# Every row has 21 fields and finite, non-negative errors.
+awk -F, 'NR > 1 { if (NF != 21) { print "bad field count: " $0; exit 1 }
                   for (i = 7; i <= 10; ++i) if ($i !~ /^[0-9.e+-]+$/ || $i < 0) { print "bad number: " $0; exit 1 } }' \
     "$out/results.csv" || fail "results.csv rows"
-head -1 "$out/results.csv" | grep -q ',cut_size,ref_noise_rmse,below_noise,part$' || fail "results.csv noise columns"
+head -1 "$out/results.csv" | grep -q ',cut_size,ref_noise_rmse,below_noise,part,renders,rmse_min,rmse_max$' \
+    || fail "results.csv noise and renders columns"
+# A point of several renders (the quick sweep's path tracer at 4 spp has 2): its RMSE is
+# their root-mean-square, so it lies between their least and greatest, which differ
+# (each render has its own seed); a point of one render has all three equal.
+awk -F, 'NR > 1 && $2 == "path" && $3 == "4 spp" && $18 == "image" {
+             found = 1
+             if ($19 != 2 || !($20 < $21) || $8 < $20 || $8 > $21) { print "bad repeated point: " $0; exit 1 } }
+         NR > 1 && $19 == 1 && ($20 != $8 || $21 != $8) { print "one render, three RMSEs: " $0; exit 1 }
+         END { if (!found) { print "no path 4 spp row"; exit 1 } }' "$out/results.csv" \
+    || fail "a point's renders"
+grep -q 'path .*4 spp .*(2 renders, RMSE ' <<<"$log" || fail "the log does not show the point's renders"
 # Stochastic runs at two cut sizes.
 [ "$(awk -F, '$2 == "vrl-stochastic" { print $15 }' "$out/results.csv" | sort -u | wc -l)" -eq 2 ] \
     || fail "vrl-stochastic should run at two cut sizes"
 # Part (d) alone: every virtual-light method, against its own reference (whose noise differs).
 for m in vrl vrl-lightcuts vrl-stochastic vpl-lightcuts; do
-    grep -q "^bathroom,$m,.*,multiple$" "$out/results.csv" || fail "no part (d) $m row in results.csv"
+    grep -q "^bathroom,$m,.*,multiple," "$out/results.csv" || fail "no part (d) $m row in results.csv"
 done
-grep -q "^bathroom,path,.*,multiple$" "$out/results.csv" && fail "the path tracer has no part (d) row"
+grep -q "^bathroom,path,.*,multiple," "$out/results.csv" && fail "the path tracer has no part (d) row"
 [ "$(awk -F, 'NR > 1 && $1 == "bathroom" { print $18 ":" $16 }' "$out/results.csv" | sort -u | wc -l)" -eq 2 ] \
     || fail "the two parts should each have one reference noise"
 grep -q "Part (d) alone" "$out/summary.md" || fail "summary.md lacks the part (d) comparison"
@@ -79,9 +90,9 @@ awk -F, 'NR > 1 && $2 == "VRL-stochastic" { if (!($5 > 0) || !($9 > 0)) { print 
     "$out/speedup.csv" || fail "stochastic speed-up rows need a time and an error"
 # A scene measured on part (d) alone (bathroom-hg07): (d) rows only, no whole-image
 # reference built, its previews and Table 1 from the (d) runs.
-grep -q '^bathroom-hg07,.*,image$' "$out/results.csv" && fail "bathroom-hg07 has whole-image rows"
+grep -q '^bathroom-hg07,.*,image,' "$out/results.csv" && fail "bathroom-hg07 has whole-image rows"
 for m in vrl vrl-lightcuts vrl-stochastic vpl-lightcuts; do
-    grep -q "^bathroom-hg07,$m,.*,multiple$" "$out/results.csv" || fail "no part (d) $m row for bathroom-hg07"
+    grep -q "^bathroom-hg07,$m,.*,multiple," "$out/results.csv" || fail "no part (d) $m row for bathroom-hg07"
 done
 ls "$out/cache" | grep -qE '^bathroom-hg07-reference-[0-9a-f]{16}\.exr$' && fail "a whole-image reference for bathroom-hg07"
 ls "$out/cache" | grep -qE '^bathroom-hg07-reference-d-[0-9a-f]{16}\.exr$' || fail "no part (d) reference for bathroom-hg07"
