@@ -107,6 +107,7 @@ void combineRenders(RunResult& r, const std::vector<std::pair<double, ImageError
         r.rmseMin = std::min(r.rmseMin, e.rmse);  // NaN (no pixel compared) stays out of both ends
         r.rmseMax = std::max(r.rmseMax, e.rmse);
     }
+    if (!(r.rmseMin <= r.rmseMax)) r.rmseMin = r.rmseMax = NAN;  // no render compared a pixel
     m.rmse = std::sqrt(squared / n);
     m.relativeRmse = std::sqrt(relativeSquared / n);
     m.smape = smape / n, m.meanReference = meanReference / n, m.meanTest = meanTest / n;
