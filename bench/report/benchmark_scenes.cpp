@@ -106,8 +106,9 @@ std::vector<MethodRun> multipleSweep(bool quick) {
 // its errors moved by a median x1.14 on part (d), x1.24 on the whole image, when
 // the seeds changed) and a repeat costs least. Those under 3.5 s a render on
 // every scene but one (bathroom-hg07's VRL Lightcuts at N = 300, 5.4 s; the paper
-// scenes are up to 1.6x bathroom): 53 points, 1.6 min a repeat, so that the full
-// report stays within its 45-minute limit (39 min with one render a point).
+// scenes are up to 1.6x bathroom): 53 points. Their two extra renders took the
+// full report from 39.3 to 43.6 min, within its 45-minute limit; more repeats
+// would not fit.
 bool cheapPoint(const MethodRun& r) {
     const bool oneSpp = r.spp == 1;
     if (!r.multipleOnly)

@@ -39,8 +39,8 @@ TEST(BenchmarkScenes, EveryRenderOfEveryListHasItsOwnSeed) {
 }
 
 TEST(BenchmarkScenes, TheFullReportRendersItsCheapestPointsThreeTimes) {
-    // The points under 3.5 s a render (bathroom, previous report), which cost 1.6 min
-    // a repeat: 53 of them in five scenes, three renders each.
+    // The points under about 3.5 s a render (the report before repeats): 53 of them
+    // in five scenes, three renders each (their two extra renders cost 4.3 min).
     size_t repeated = 0;
     for (const BenchmarkScene& s : scenes(false))
         for (const MethodRun& r : s.runs) {
