@@ -8,7 +8,9 @@ Usage:
 Writes, for every scene in results.csv, DIR/error-time-<scene>.png: three
 log-log panels (RMSE, relative RMSE, SMAPE against wall time in seconds), one
 curve per method (or per method and error threshold for the Lightcuts
-methods when several thresholds were run).
+methods when several thresholds were run). A point of several renders
+(columns renders, rmse_min, rmse_max) has a vertical bar on the RMSE panel:
+the range of its renders' RMSEs.
 
 If --speedup names a file with at least one usable row, also writes
 DIR/speedup.png: the speed-up of Lightcuts over brute force against the
@@ -393,7 +395,7 @@ def main(argv=None):
         description="Plot error-against-time and Lightcuts speed-up figures "
                     "from vrlcuts benchmark CSVs.")
     parser.add_argument("--results", required=True,
-                        help="results.csv, one row per render")
+                        help="results.csv, one row per point (a point of several renders: their mean time and root-mean-square RMSE, with rmse_min and rmse_max)")
     parser.add_argument("--speedup",
                         help="speedup.csv (optional; skipped when absent "
                              "or without rows)")

@@ -104,9 +104,13 @@ std::vector<MethodRun> multipleSweep(bool quick) {
 // The full report's cheapest points, rendered kCheapRepeats times: one render's
 // error moves most with the seed there (the previous report, one render a point:
 // its errors moved by a median x1.14 on part (d), x1.24 on the whole image, when
-// the seeds changed) and a repeat costs least. Those under 3.5 s a render on
-// every scene but one (bathroom-hg07's VRL Lightcuts at N = 300, 5.4 s; the paper
-// scenes are up to 1.6x bathroom): 53 points. Their two extra renders took the
+// the seeds changed) and a repeat costs least. Chosen by setting, none the last
+// of its curve: the whole image's path tracing at 8 and 32 spp, plain VRLs at
+// N = 100 and the stochastic cuts at 1 spp; part (d)'s plain VRLs at N = 250,
+// VRL Lightcuts at N = 300 (both thresholds) and N = 1k (e = 0.1), the stochastic
+// cuts at 1 spp and K = 8 at 4 spp. All took under 3.5 s a render in the report
+// before repeats but one (bathroom-hg07's VRL Lightcuts at N = 300, 5.4 s); the
+// whole image's VRL Lightcuts at N = 300, 2 spp (3.2-5.5 s) is not repeated. 53 points. Their two extra renders took the
 // full report from 39.3 to 43.6 min, within its 45-minute limit; more repeats
 // would not fit.
 bool cheapPoint(const MethodRun& r) {

@@ -107,7 +107,10 @@ void combineRenders(RunResult& r, const std::vector<std::pair<double, ImageError
         r.rmseMin = std::min(r.rmseMin, e.rmse);  // NaN (no pixel compared) stays out of both ends
         r.rmseMax = std::max(r.rmseMax, e.rmse);
     }
-    if (!(r.rmseMin <= r.rmseMax)) r.rmseMin = r.rmseMax = NAN;  // no render compared a pixel
+    // A render that compared no pixel (NaN) makes the whole point NaN, its range too.
+    const bool unmeasured = std::any_of(renders.begin(), renders.end(),
+                                        [](const auto& render) { return std::isnan(render.second.rmse); });
+    if (unmeasured) r.rmseMin = r.rmseMax = NAN;
     m.rmse = std::sqrt(squared / n);
     m.relativeRmse = std::sqrt(relativeSquared / n);
     m.smape = smape / n, m.meanReference = meanReference / n, m.meanTest = meanTest / n;
@@ -1032,9 +1035,11 @@ void writeSummary(const fs::path& path, const Options& o, const std::vector<Scen
           "**Points of several renders.** One render's error moves with its seed, most at the cheapest settings, "
           "so those are rendered more than once, each render from its own seed (the renders column says how many "
           "and the range of their RMSEs; `results.csv`: renders, rmse_min, rmse_max). Such a point's time is the "
-          "renders' mean, its RMSE and relative RMSE their root-mean-square (the expected squared error, which an "
-          "unbiased method's time buys down), its SMAPE their mean; the images and cut statistics are the first "
-          "render's.\n\n";
+          "renders' mean, its RMSE and relative RMSE their root-mean-square (the root of an estimate of the expected "
+          "squared error, which an unbiased method's time buys down), its SMAPE their mean; the images and cut statistics are the first "
+          "render's. The vertical bars on the RMSE plots are those ranges. A point's \"mean ratio\" is its renders' "
+          "mean. One render's RMSE is on average a little below the root of its expected squared error (the "
+          "square root is concave), so a point of one render sits a little low beside one of three.\n\n";
     md << "## Scenes\n\n| scene | description | resolution | reference (whole image) | its noise RMSE / rel. RMSE / "
           "SMAPE | part (d) reference | its noise RMSE / rel. RMSE / SMAPE |\n|---|---|---|---|---|---|---|\n";
     for (const auto& s : scenes) {

@@ -31,7 +31,8 @@ for m in path vrl vrl-lightcuts vrl-stochastic vpl-lightcuts; do
 done
 # Every row has 21 fields and finite, non-negative errors.
 awk -F, 'NR > 1 { if (NF != 21) { print "bad field count: " $0; exit 1 }
-                  for (i = 7; i <= 10; ++i) if ($i !~ /^[0-9.e+-]+$/ || $i < 0) { print "bad number: " $0; exit 1 } }' \
+                  for (i = 7; i <= 10; ++i) if ($i !~ /^[0-9.e+-]+$/ || $i < 0) { print "bad number: " $0; exit 1 }
+                  for (i = 19; i <= 21; ++i) if ($i !~ /^[0-9.e+-]+$/ || $i < 0) { print "bad renders or range: " $0; exit 1 } }' \
     "$out/results.csv" || fail "results.csv rows"
 head -1 "$out/results.csv" | grep -q ',cut_size,ref_noise_rmse,below_noise,part,renders,rmse_min,rmse_max$' \
     || fail "results.csv noise and renders columns"
