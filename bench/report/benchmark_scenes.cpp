@@ -110,9 +110,9 @@ std::vector<MethodRun> multipleSweep(bool quick) {
 // VRL Lightcuts at N = 300 (both thresholds) and N = 1k (e = 0.1), the stochastic
 // cuts at 1 spp and K = 8 at 4 spp. All took under 3.5 s a render in the report
 // before repeats but one (bathroom-hg07's VRL Lightcuts at N = 300, 5.4 s); the
-// whole image's VRL Lightcuts at N = 300, 2 spp (3.2-5.5 s) is not repeated. 53 points. Their two extra renders took the
-// full report from 39.3 to 43.6 min, within its 45-minute limit; more repeats
-// would not fit.
+// whole image's VRL Lightcuts at N = 300, 2 spp (3.2-5.5 s) is not repeated.
+// 53 points. Their two extra renders took the full report from 39.3 to 43.6 min,
+// within its 45-minute limit; more repeats would not fit.
 bool cheapPoint(const MethodRun& r) {
     const bool oneSpp = r.spp == 1;
     if (!r.multipleOnly)

@@ -32,9 +32,9 @@ struct MethodRun {
     bool multipleOnly = false;  // part (d) alone (the paper's Figure 3 comparison), against the (d) reference
     // Renders of this point, each from its own seed: the point's error is the
     // root-mean-square of their RMSEs (the square root of an estimate of the
-    // expected MSE, what falls as 1/time for an unbiased method) and its time their mean. More than one for the
-    // cheapest points, where one render's error moves most with the seed and a
-    // repeat costs least.
+    // expected MSE, what falls as 1/time for an unbiased method) and its time
+    // their mean. More than one for the cheapest points, where one render's error
+    // moves most with the seed and a repeat costs least.
     int repeats = 1;
     std::string label() const;  // no commas (a CSV field)
     // The curve the run belongs to: method, and threshold or cut size where a method has several.

@@ -94,6 +94,7 @@ void combineRenders(RunResult& r, const std::vector<std::pair<double, ImageError
     const double n = double(renders.size());
     double seconds = 0.0, squared = 0.0, relativeSquared = 0.0, smape = 0.0, meanReference = 0.0, meanTest = 0.0;
     ImageErrorMetrics m;
+    bool unmeasured = false;  // a render that compared no pixel (NaN RMSE) makes the whole point NaN, its range too
     r.rmseMin = INFINITY, r.rmseMax = -INFINITY;
     for (const auto& [time, e] : renders) {
         seconds += time;
@@ -104,12 +105,10 @@ void combineRenders(RunResult& r, const std::vector<std::pair<double, ImageError
         meanTest += e.meanTest;
         m.pixels += e.pixels;
         m.nonFinitePixels += e.nonFinitePixels;
-        r.rmseMin = std::min(r.rmseMin, e.rmse);  // NaN (no pixel compared) stays out of both ends
+        r.rmseMin = std::min(r.rmseMin, e.rmse);
         r.rmseMax = std::max(r.rmseMax, e.rmse);
+        unmeasured |= std::isnan(e.rmse);
     }
-    // A render that compared no pixel (NaN) makes the whole point NaN, its range too.
-    const bool unmeasured = std::any_of(renders.begin(), renders.end(),
-                                        [](const auto& render) { return std::isnan(render.second.rmse); });
     if (unmeasured) r.rmseMin = r.rmseMax = NAN;
     m.rmse = std::sqrt(squared / n);
     m.relativeRmse = std::sqrt(relativeSquared / n);
