@@ -225,6 +225,8 @@ int runRender(const RenderCommandOptions& o, const CLI::App& command) {
                      stats.tracingSeconds, (unsigned long long)stats.lightPaths, (unsigned long long)stats.vrlCount,
                      usesVpls(settings.method) ? "VPLs" : "VRLs",
                      double(stats.vrlBytes) / (1024.0 * 1024.0), sizeof(Vrl));
+        if (usesVpls(settings.method))
+            std::fprintf(stderr, "  %d distance samples per camera segment\n", settings.vplDistanceSamples);
         if (settings.vrlSets > 1)
             std::fprintf(stderr, "  %d independent VRL sets (counts above are over all of them); sample s uses set s mod %d\n",
                          settings.vrlSets, settings.vrlSets);

@@ -32,9 +32,9 @@ void addRenderOptions(CLI::App& cmd, RenderCommandOptions& o) {
                     "vrl-lightcuts (the same, (c) and (d) by cuts through a VRL light tree), vrl-stochastic (stochastic "
                     "VRL Lightcuts: (c) and (d) by small stochastic cuts through the same tree, one VRL drawn under each "
                     "node, unbiased; --spp applies to (c) and (d) too) or vpl-lightcuts (the "
-                    "paper's baseline: (d) by Lightcuts over VPLs at the light paths' medium collisions, 32 stratified "
-                    "distance samples per camera segment, (c) path-sampled; vpl: the same with every VPL gathered, no "
-                    "tree). No method clamps contributions")
+                    "paper's baseline: (d) by Lightcuts over VPLs at the light paths' medium collisions, stratified "
+                    "distance samples along each camera segment (--distance-samples), (c) path-sampled; vpl: the "
+                    "same with every VPL gathered, no tree). No method clamps contributions")
         ->check(CLI::IsMember(renderMethodNames()));
     cmd.add_option("--spp", o.spp,
                    "Samples per pixel (default: the scene's sampler sampleCount); with --time-limit, the most "
@@ -121,6 +121,11 @@ void addRenderOptions(CLI::App& cmd, RenderCommandOptions& o) {
                    "vrl-stochastic: independent VRL sets of --vrls each (own light paths, own trees); camera sample s "
                    "uses set s mod this, so the image converges to the true transport, not one set's (default 1)")
         ->check(CLI::Range(1u, uint32_t(kMaxVrlSets)));
+    cmd.add_option("--distance-samples", o.distanceSamples,
+                   "vpl, vpl-lightcuts: stratified distance samples per camera segment, each gathering the VPLs "
+                   "(by a cut for vpl-lightcuts); their cost grows with it, the noise of the distance sampling "
+                   "falls (default 32)")
+        ->check(CLI::Range(1u, uint32_t(kMaxVplDistanceSamples)));
     cmd.add_flag("--pixel-centres", o.pixelCentres,
                  "Camera rays through pixel centres, the paper's setting (default: jittered inside each pixel, "
                  "antialiased, as Mitsuba and pbrt do; still bit-identical across threads and workers)");
@@ -149,6 +154,7 @@ void warnIneffectiveFlags(const CLI::App& command, RenderMethod method, bool dis
         {"--partition-size", tree, "vrl-lightcuts, vrl-stochastic and vpl-lightcuts"},
         {"--cut-size", method == RenderMethod::VrlStochastic, "vrl-stochastic"},
         {"--exact-distance-below", method == RenderMethod::VrlLightcuts, "vrl-lightcuts"},
+        {"--distance-samples", usesVpls(method), "vpl and vpl-lightcuts"},
     };
     const std::string name(methodName(method));
     for (const Rule& rule : rules)
@@ -235,6 +241,7 @@ v1::RenderParameters toRenderParameters(const RenderCommandOptions& o) {
     p.set_partition_size(o.partitionSize);
     p.set_cut_size(o.cutSize);
     p.set_vrl_sets(o.vrlSets);
+    p.set_vpl_distance_samples(o.distanceSamples);
     return p;
 }
 

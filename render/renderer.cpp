@@ -81,7 +81,10 @@ void validateRenderSettings(const RenderSettings& settings) {
     if (settings.samplesPerPixel < 1) throw std::invalid_argument("samples per pixel must be at least 1");
     if (settings.vrlSamples < 1) throw std::invalid_argument("samples per VRL must be at least 1");
     if (!(settings.cut.errorThreshold >= 0.0f)) throw std::invalid_argument("the error threshold must be >= 0");
-    if (settings.vplDistanceSamples < 1) throw std::invalid_argument("VPL distance samples must be at least 1");
+    if (settings.vplDistanceSamples < 1 || settings.vplDistanceSamples > kMaxVplDistanceSamples)
+        throw std::invalid_argument("the VPL distance samples per camera segment must be in [1, " +
+                                    std::to_string(kMaxVplDistanceSamples) + "], not " +
+                                    std::to_string(settings.vplDistanceSamples));
     if (settings.cut.stochasticCutSize < 1 || settings.cut.stochasticCutSize > (1u << 20))
         throw std::invalid_argument("the stochastic cut size must be in [1, 1048576], not " +
                                     std::to_string(settings.cut.stochasticCutSize));

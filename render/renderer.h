@@ -77,6 +77,10 @@ constexpr bool usesVirtualLights(RenderMethod m) { return m != RenderMethod::Pat
 // The most independent VRL sets a render takes (RenderSettings::vrlSets).
 inline constexpr int kMaxVrlSets = 1024;
 
+// The most distance samples per camera segment the VPL methods take
+// (RenderSettings::vplDistanceSamples): each is one cut (or gather) per segment.
+inline constexpr int kMaxVplDistanceSamples = 4096;
+
 // The longest time limit a render takes (about 116 days): a guard against typos such as 1e30.
 inline constexpr double kMaxTimeLimitSeconds = 1e7;
 
@@ -98,7 +102,7 @@ struct RenderSettings {
     int vrlSamples = 1;          // (u, v) samples per VRL and camera segment
     // vrl-lightcuts method
     CutSettings cut;             // error threshold, maximum cut, bound parameters
-    int vplDistanceSamples = 32;  // vpl-lightcuts: stratified distance samples per camera segment
+    int vplDistanceSamples = 32;  // vpl, vpl-lightcuts: stratified distance samples per camera segment
     uint32_t partitionSize = 2048;  // light tree: VRLs per partition of the median-split phase
     // vrl-stochastic only: independent VRL sets of vrlCount VRLs each (own light-tracing
     // streams, own trees); camera sample s uses set s mod vrlSets, so the image converges
@@ -132,8 +136,9 @@ struct RenderStatistics {
 using ProgressCallback = std::function<void(const char* phase, double fraction)>;
 
 // Checks the settings; throws std::invalid_argument for a non-positive sample
-// count, a negative error threshold, a negative or non-finite time limit, or
-// vrlSets outside [1, kMaxVrlSets] or above 1 for another method than vrl-stochastic.
+// count, a negative error threshold, a negative or non-finite time limit,
+// vplDistanceSamples outside [1, kMaxVplDistanceSamples], or vrlSets outside
+// [1, kMaxVrlSets] or above 1 for another method than vrl-stochastic.
 void validateRenderSettings(const RenderSettings& settings);
 
 // The per-image light work of a render (the coordinator's part in the service):

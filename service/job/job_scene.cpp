@@ -79,6 +79,7 @@ v1::RenderParameters defaultRenderParameters(RenderMethod method) {
     p.set_partition_size(d.partitionSize);
     p.set_cut_size(d.cut.stochasticCutSize);
     p.set_vrl_sets(uint32_t(d.vrlSets));
+    p.set_vpl_distance_samples(uint32_t(d.vplDistanceSamples));
     return p;
 }
 
@@ -124,6 +125,10 @@ void validateJobSpec(const v1::JobSpec& spec, const ServiceLimits& limits) {
     if (p.cut_size() > (1u << 20))
         throw JobSpecError("the stochastic cut size must be in 1..." + std::to_string(1u << 20) +
                            " (0: the default), got " + std::to_string(p.cut_size()));
+    if (p.vpl_distance_samples() > uint32_t(kMaxVplDistanceSamples))
+        throw JobSpecError("the VPL distance samples per camera segment must be in 1..." +
+                           std::to_string(kMaxVplDistanceSamples) + " (0: the default), got " +
+                           std::to_string(p.vpl_distance_samples()));
     if (p.vrl_sets() > uint32_t(kMaxVrlSets))
         throw JobSpecError("the VRL sets must be in 1..." + std::to_string(kMaxVrlSets) + " (0: one), got " +
                            std::to_string(p.vrl_sets()));
@@ -222,6 +227,7 @@ ResolvedJob resolveJob(const std::filesystem::path& sceneFile, const v1::JobSpec
     s.partitionSize = p.partition_size();
     if (p.cut_size() > 0) s.cut.stochasticCutSize = p.cut_size();
     s.vrlSets = p.vrl_sets() > 0 ? int(p.vrl_sets()) : 1;
+    if (p.vpl_distance_samples() > 0) s.vplDistanceSamples = int(p.vpl_distance_samples());
     try {
         validateRenderSettings(s);
     } catch (const std::invalid_argument& e) {

@@ -150,6 +150,30 @@ TEST(ResolveJob, VrlSetsAreForVrlStochasticWithinTheVrlLimit) {
     rejects(lightcuts, {}, "need the vrl-stochastic method");
 }
 
+// The VPL methods' distance samples travel in the spec (0: the default, 32) and
+// are checked against kMaxVplDistanceSamples before any work.
+TEST(ResolveJob, VplDistanceSamplesComeFromTheSpec) {
+    const test::TempDir dir("vrl-job-scene");
+    const auto scene = writeScene(dir, "");
+    v1::JobSpec spec = specWithMethod("vpl-lightcuts");
+    EXPECT_EQ(rpc::defaultRenderParameters(RenderMethod::VplLightcuts).vpl_distance_samples(),
+              uint32_t(RenderSettings{}.vplDistanceSamples));
+    spec.mutable_parameters()->set_vpl_distance_samples(0);
+    EXPECT_EQ(rpc::resolveJob(scene, spec, {}).settings.vplDistanceSamples, RenderSettings{}.vplDistanceSamples);
+    spec.mutable_parameters()->set_vpl_distance_samples(4);
+    EXPECT_EQ(rpc::resolveJob(scene, spec, {}).settings.vplDistanceSamples, 4);
+    spec.mutable_parameters()->set_vpl_distance_samples(uint32_t(kMaxVplDistanceSamples) + 1);
+    try {
+        rpc::validateJobSpec(spec, {});
+        ADD_FAILURE() << "distance samples " << kMaxVplDistanceSamples + 1 << " accepted";
+    } catch (const rpc::JobSpecError& e) {
+        EXPECT_NE(std::string(e.what()).find("VPL distance samples per camera segment must be in 1..." +
+                                             std::to_string(kMaxVplDistanceSamples)),
+                  std::string::npos)
+            << e.what();
+    }
+}
+
 TEST(ResolveJob, CropAppliesAfterTheResolution) {
     const test::TempDir dir("vrl-job-scene");
     const auto scene = writeScene(dir, "");
