@@ -32,7 +32,7 @@ RESULTS_COLUMNS = [
     "scene", "method", "setting", "vrls", "spp", "error_threshold",
     "seconds", "rmse", "rel_rmse", "smape", "mean_eval", "mean_inter",
     "mean_cut", "mean_ratio", "cut_size", "ref_noise_rmse", "below_noise",
-    "part", "renders", "rmse_min", "rmse_max",
+    "part", "renders", "rmse_min", "rmse_max", "distance_samples",
 ]
 SPEEDUP_COLUMNS = [
     "scene", "kind", "n", "brute_seconds_per_pixel",

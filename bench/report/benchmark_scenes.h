@@ -22,13 +22,16 @@ constexpr int kReferenceChunks = 8;
 // One render of the sweep. `lights`: VRLs or VPLs (0 for the path tracer);
 // `spp`: samples per pixel (path tracer; parts (a)-(c) of the virtual-light
 // methods; for stochastic VRL Lightcuts also parts (c) and (d): each sample
-// draws new cuts); `cutSize`: stochastic VRL Lightcuts' K (0 for the others).
+// draws new cuts); `cutSize`: stochastic VRL Lightcuts' K (0 for the others);
+// `distanceSamples`: VPL Lightcuts' distance samples per camera segment (0: the
+// renderer's default, 32; the label shows any other value as "D=...").
 struct MethodRun {
     RenderMethod method = RenderMethod::Path;
     uint64_t lights = 0;
     int spp = 1;
     float errorThreshold = 0.02f;
     uint32_t cutSize = 0;
+    int distanceSamples = 0;
     bool multipleOnly = false;  // part (d) alone (the paper's Figure 3 comparison), against the (d) reference
     // Renders of this point, each from its own seed: the point's error is the
     // root-mean-square of their RMSEs (the square root of an estimate of the
@@ -54,6 +57,9 @@ struct BenchmarkScene {
     bool shared = false;            // from ../shared/scenes (skipped with a reason when absent)
     std::map<std::string, std::string> defines;
     std::string medium;             // --medium fill, or empty
+    // Its part (d) reference is checked against another method's estimate
+    // (stochastic VRL Lightcuts over independent VRL sets; stored beside it).
+    bool checkPartReference = false;
     int width = 64, height = 48;
     int maxDepth = 12;              // the paper's "maximum path length is 12 for all the scenes"
     int referenceSpp = 256;         // path tracer; two independent halves of referenceSpp / 2

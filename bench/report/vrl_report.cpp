@@ -89,6 +89,12 @@ struct RunResult {
     bool belowNoise() const { return metrics.rmse < kNoiseFactor * referenceNoiseRmse; }
 };
 
+// results.csv's distance_samples: the VPL methods' distance samples per camera segment, 0 for the others.
+int distanceSamplesColumn(const MethodRun& run) {
+    if (!usesVpls(run.method)) return 0;
+    return run.distanceSamples > 0 ? run.distanceSamples : RenderSettings{}.vplDistanceSamples;
+}
+
 // The point of `renders` (each one render's time and metrics against the same reference).
 void combineRenders(RunResult& r, const std::vector<std::pair<double, ImageErrorMetrics>>& renders) {
     const double n = double(renders.size());
@@ -530,6 +536,8 @@ struct ReferenceCheck {
     uint64_t vrls = 0;
     double differenceRmse = 0.0, expectedRmse = 0.0, seconds = 0.0;
     double checkNoiseRmse = 0.0;  // of the check's mean
+    bool cached = false;  // read from beside the reference (seconds then as recorded)
+    std::string commit;   // the code that computed it
     bool done() const { return sets > 0; }
 };
 
@@ -537,6 +545,7 @@ ReferenceCheck checkPartReference(const BenchmarkScene& s, const Scene& scene, c
                                   const ReferenceInfo& info, int sets, uint64_t vrls, int spp, const Log& log) {
     ReferenceCheck c;
     c.sets = sets, c.vrls = vrls, c.spp = spp;
+    c.commit = gitCommit();
     const auto start = Clock::now();
     const size_t n = size_t(s.width) * size_t(s.height);
     std::vector<double> sum(n, 0.0), sum2(n, 0.0);
@@ -564,6 +573,65 @@ ReferenceCheck checkPartReference(const BenchmarkScene& s, const Scene& scene, c
     log.line("%s: part (d) reference check: stochastic VRL Lightcuts over %d sets of %llu: RMSE of the difference %.4g, expected "
              "from the noises %.4g (ratio %.2f)", s.name.c_str(), sets, (unsigned long long)vrls, c.differenceRmse,
              c.expectedRmse, c.differenceRmse / c.expectedRmse);
+    return c;
+}
+
+// The check of a stored part (d) reference, kept beside it as the reference is
+// (<reference>.check.txt, named by its file, keyed by that file and the check's
+// settings): computed once, by --references or by the first report run that finds
+// none, then read (the check is of the reference, which a report run only reads;
+// it took 2.5 min of the full report). A file of other settings, or one that does
+// not parse, is said so and replaced.
+ReferenceCheck storedPartReferenceCheck(const BenchmarkScene& s, const Scene& scene, const Image& reference,
+                                        const ReferenceInfo& info, const Log& log) {
+    constexpr int kSets = 16, kSpp = 8;
+    constexpr uint64_t kVrls = 10000;
+    const fs::path file = fs::path(info.file).replace_extension(".check.txt");
+    const std::string key = "stochastic VRL Lightcuts K=32 sets=" + std::to_string(kSets) + " vrls=" +
+                            std::to_string(kVrls) + " spp=" + std::to_string(kSpp) + " seeds=3000017+set version=" +
+                            VRL_VERSION + " reference=" + info.file.filename().string();
+    if (fs::exists(file)) {
+        std::ifstream in(file);
+        std::map<std::string, std::string> fields;
+        for (std::string line; std::getline(in, line);)
+            if (const size_t colon = line.find(": "); colon != std::string::npos)
+                fields[line.substr(0, colon)] = line.substr(colon + 2);
+        ReferenceCheck c;
+        c.sets = kSets, c.vrls = kVrls, c.spp = kSpp, c.cached = true, c.commit = fields["commit"];
+        const auto number = [&](const char* name, double& value) {
+            try {
+                size_t used = 0;
+                value = std::stod(fields.at(name), &used);
+                return used == fields.at(name).size() && std::isfinite(value);
+            } catch (const std::exception&) {
+                return false;
+            }
+        };
+        if (fields["key"] != key)
+            log.line("%s: %s is of other settings (key '%s', expected '%s'): computing the check again",
+                     s.name.c_str(), file.filename().c_str(), fields["key"].c_str(), key.c_str());
+        else if (!number("difference RMSE", c.differenceRmse) || !number("expected RMSE", c.expectedRmse) ||
+                 !number("check noise RMSE", c.checkNoiseRmse) || !number("seconds", c.seconds))
+            log.line("%s: %s lacks a number or does not parse: computing the check again", s.name.c_str(),
+                     file.filename().c_str());
+        else {
+            log.line("%s: part (d) reference check from the cache (%s): RMSE of the difference %.4g, expected from the "
+                     "noises %.4g (ratio %.2f)", s.name.c_str(), file.filename().c_str(), c.differenceRmse,
+                     c.expectedRmse, c.differenceRmse / c.expectedRmse);
+            return c;
+        }
+    }
+    const ReferenceCheck c = checkPartReference(s, scene, reference, info, kSets, kVrls, kSpp, log);
+    const fs::path writing = fs::path(file).concat(".writing");
+    {
+        std::ofstream out(writing);
+        out << std::setprecision(17) << "part (d) reference check of " << info.file.filename().string()
+            << "\nkey: " << key << "\ncommit: " << c.commit << "\nseconds: " << c.seconds
+            << "\ndifference RMSE: " << c.differenceRmse << "\nexpected RMSE: " << c.expectedRmse
+            << "\ncheck noise RMSE: " << c.checkNoiseRmse << "\n";
+        if (!out) throw std::runtime_error("cannot write " + writing.string());
+    }
+    fs::rename(writing, file);
     return c;
 }
 
@@ -737,7 +805,7 @@ std::string curveTitle(std::string curve) {
 struct SceneReport {
     BenchmarkScene scene;
     ReferenceInfo reference, partReference;
-    ReferenceCheck partCheck;  // the first scene's only
+    ReferenceCheck partCheck;  // the scene that checks its part (d) reference (BenchmarkScene::checkPartReference)
     double loadSeconds = 0.0;
     std::string skipped;  // reason, if skipped
     std::map<RenderMethod, std::pair<double, double>> tableStats;  // method -> (#Eval, #Inter)
@@ -1025,9 +1093,10 @@ void writeSummary(const fs::path& path, const Options& o, const std::vector<Scen
           "noise is part of the whole image's error, and the spp grow with N along each curve) and parts (c) and (d) "
           "with their VRLs: plain VRLs and VRL Lightcuts (relative error threshold e, 0.02 unless stated) once per "
           "pixel, stochastic VRL Lightcuts at every sample (K VRLs per camera segment and surface point). VPL "
-          "Lightcuts path-samples part (c) too and gathers (d) at 32 stratified distance samples per camera segment "
-          "without clamping, as in the paper. Errors are on luminance; SMAPE uses epsilon 0.01. Rays pass through "
-          "pixel centres; maximum path length 12.\n\n"
+          "Lightcuts path-samples part (c) too and gathers (d) without clamping, as in the paper, at 32 stratified "
+          "distance samples per camera segment (its cost floor), or D where a label says D=... (`results.csv`: "
+          "distance_samples; `vrl render --distance-samples`). Errors are on luminance; SMAPE uses epsilon 0.01. "
+          "Rays pass through pixel centres; maximum path length 12.\n\n"
           "**Noise rule.** A run whose RMSE is below " << fmt(kNoiseFactor) << "× the reference's own estimated RMSE "
           "cannot be told from the reference's noise: it is marked ‡ in the tables, written with below_noise = 1 in "
           "`results.csv`, and left out of every ratio (its curve then ends before it).\n\n"
@@ -1079,7 +1148,11 @@ void writeSummary(const fs::path& path, const Options& o, const std::vector<Scen
            << fmt(s.partReference.seconds) << " s, noise " << fmt(s.partReference.noiseRmse)
            << (s.partReference.cached ? ", time as recorded in the cache" : "") << "), stochastic VRL Lightcuts over "
            << "sets " << fmt(c.seconds * c.checkNoiseRmse * c.checkNoiseRmse) << " (" << fmt(c.seconds)
-           << " s, noise " << fmt(c.checkNoiseRmse) << ").\n\n";
+           << " s, noise " << fmt(c.checkNoiseRmse) << ")."
+           << (c.cached ? " The check is stored beside the reference (computed by commit " + c.commit +
+                              "; its time as recorded there)."
+                        : "")
+           << "\n\n";
     }
     for (const auto& s : scenes) {
         if (!s.skipped.empty()) continue;
@@ -1179,10 +1252,10 @@ int runReport(const Options& o) {
             const Image partReference =
                 referenceImage(s, *scene, ReferencePart::Multiple, referenceDir, log, report.partReference, left,
                                o.buildReferences);
+            // The part (d) reference against another method's estimate, on one scene.
+            if (s.checkPartReference && !report.partReference.incomplete)
+                report.partCheck = storedPartReferenceCheck(s, *scene, partReference, report.partReference, log);
             if (o.buildReferences) return;
-            if (scenes.empty())  // the first scene: the part (d) reference against plain VRLs over independent sets
-                report.partCheck =
-                    checkPartReference(s, *scene, partReference, report.partReference, 16, 10000, 8, log);
             // The previews show the whole image, or part (d) where that is all a scene measures.
             const Image& shown = wholeImage ? reference : partReference;
             const float exposure = autoExposure(shown);
@@ -1303,7 +1376,7 @@ int runReport(const Options& o) {
         // Write what we have after every scene: a long report interrupted keeps its data.
         std::ofstream csv(o.out / "results.csv");
         csv << "scene,method,setting,vrls,spp,error_threshold,seconds,rmse,rel_rmse,smape,mean_eval,mean_inter,mean_cut,"
-               "mean_ratio,cut_size,ref_noise_rmse,below_noise,part,renders,rmse_min,rmse_max\n";
+               "mean_ratio,cut_size,ref_noise_rmse,below_noise,part,renders,rmse_min,rmse_max,distance_samples\n";
         csv << std::setprecision(6);
         for (const auto& r : results)
             csv << r.scene << "," << methodName(r.run.method) << "," << r.run.label() << "," << r.run.lights << "," << r.run.spp << ","
@@ -1313,7 +1386,8 @@ int runReport(const Options& o) {
                 << (r.metrics.meanReference > 0 ? r.metrics.meanTest / r.metrics.meanReference : 0.0) << ","
                 << r.run.cutSize << "," << r.referenceNoiseRmse << "," << (r.belowNoise() ? 1 : 0) << ","
                 << (r.run.multipleOnly ? "multiple" : "image") << "," << r.renders << "," << r.rmseMin << ","
-                << r.rmseMax << "\n";
+                << r.rmseMax << "," << distanceSamplesColumn(r.run)
+                << "\n";
         std::ofstream sp(o.out / "speedup.csv");
         sp << "scene,kind,n,brute_seconds_per_pixel,lightcuts_seconds_per_pixel,speedup,mean_eval,mean_inter,"
               "rel_rmse\n";

@@ -111,3 +111,20 @@ TEST(BenchmarkScenes, ASeedIsTheFirst64BitsOfTheSha256OfSceneCurveAndLabel) {
     // A point's second render: int(hashlib.sha256(b"bathroom\npath\n4 spp\nrepeat 1").hexdigest()[:16], 16).
     EXPECT_EQ(run.seed("bathroom", 1), 1214562105443344340ull);
 }
+
+TEST(BenchmarkScenes, AVplRunCanAskForItsDistanceSamples) {
+    const BenchmarkScene s = scenes(false).front();
+    MethodRun run;
+    run.method = RenderMethod::VplLightcuts;
+    run.lights = 100;
+    run.multipleOnly = true;
+    // The default: the label (and so the seed) of the reports before distanceSamples existed.
+    ASSERT_EQ(run.label(), "N=100 e=0.02 1 spp");
+    EXPECT_EQ(runSettings(s, run).vplDistanceSamples, RenderSettings{}.vplDistanceSamples);
+    MethodRun fewer = run;
+    fewer.distanceSamples = 4;
+    EXPECT_EQ(fewer.label(), "N=100 e=0.02 1 spp D=4");
+    EXPECT_EQ(fewer.curve(), run.curve()) << "the same curve, a cheaper point";
+    EXPECT_EQ(runSettings(s, fewer).vplDistanceSamples, 4);
+    EXPECT_NE(fewer.seed(s.name), run.seed(s.name));
+}

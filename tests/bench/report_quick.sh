@@ -29,13 +29,19 @@ head -1 "$out/results.csv" | grep -q '^scene,method,setting,vrls,spp,error_thres
 for m in path vrl vrl-lightcuts vrl-stochastic vpl-lightcuts; do
     grep -q "^bathroom,$m," "$out/results.csv" || fail "no $m row in results.csv"
 done
-# Every row has 21 fields and finite, non-negative errors.
-awk -F, 'NR > 1 { if (NF != 21) { print "bad field count: " $0; exit 1 }
+# Every row has 22 fields and finite, non-negative errors.
+awk -F, 'NR > 1 { if (NF != 22) { print "bad field count: " $0; exit 1 }
                   for (i = 7; i <= 10; ++i) if ($i !~ /^[0-9.e+-]+$/ || $i < 0) { print "bad number: " $0; exit 1 }
                   for (i = 19; i <= 21; ++i) if ($i !~ /^[0-9.e+-]+$/ || $i < 0) { print "bad renders or range: " $0; exit 1 } }' \
     "$out/results.csv" || fail "results.csv rows"
-head -1 "$out/results.csv" | grep -q ',cut_size,ref_noise_rmse,below_noise,part,renders,rmse_min,rmse_max$' \
-    || fail "results.csv noise and renders columns"
+head -1 "$out/results.csv" | grep -q ',cut_size,ref_noise_rmse,below_noise,part,renders,rmse_min,rmse_max,distance_samples$' \
+    || fail "results.csv noise, renders and distance samples columns"
+# VPL Lightcuts' distance samples per camera segment: 32 unless the label asks for
+# fewer ("D=8": the quick sweep's cheaper part (d) point); 0 for the other methods.
+awk -F, 'NR > 1 { want = ($2 != "vpl-lightcuts") ? 0 : ($3 ~ / D=8$/) ? 8 : 32
+                  if ($22 != want) { print "distance samples: " $0; exit 1 }
+                  if ($3 ~ / D=8$/) found = 1 }
+         END { if (!found) { print "no D=8 row"; exit 1 } }' "$out/results.csv" || fail "distance_samples column"
 # A point of several renders (the quick sweep's path tracer at 4 spp has 2): its RMSE is
 # their root-mean-square, so it lies between their least and greatest, which differ
 # (each render has its own seed); a point of one render has all three equal.
@@ -120,4 +126,15 @@ grep -E '^\| bathroom \| 10000 \|.*\| [0-9.e+]+ \| [0-9.e+]+ \|$' "$out/summary.
 second=$("$report" --quick --no-plots -o "$out" 2>&1) || fail "the second run failed: $second"
 grep -q "reference from the cache" <<<"$second" || fail "the reference was not cached"
 grep -q "part (d) reference from the cache" <<<"$second" || fail "the part (d) reference was not cached"
+# The part (d) reference's check is stored beside it and read back; a stored check of
+# other settings is said so and computed again (here by --references, which computes it too).
+check=$(ls "$out"/cache/bathroom-reference-d-*.check.txt) || fail "no check stored beside the part (d) reference"
+grep -q "part (d) reference check from the cache ($(basename "$check"))" <<<"$second" || fail "the check was not read back"
+grep -q "they agree within their noise" "$out/summary.md" || fail "the stored check does not agree"
+grep -q "The check is stored beside the reference (computed by commit" "$out/summary.md" || fail "summary: stored check"
+sed -i 's/^key: .*/key: another check/' "$check"
+third=$("$report" --quick --references --scenes bathroom -o "$out" 2>&1) || fail "--references failed: $third"
+grep -q "$(basename "$check") is of other settings (key 'another check'" <<<"$third" || { echo "$third"; fail "a foreign check was used"; }
+grep -q "part (d) reference check: stochastic VRL Lightcuts over 16 sets" <<<"$third" || fail "the check was not computed again"
+grep -q "^key: stochastic VRL Lightcuts K=32 sets=16" "$check" || fail "the check was not stored again"
 echo "PASS"
