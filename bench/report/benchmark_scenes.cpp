@@ -20,10 +20,6 @@ std::string compactCount(uint64_t n) {
     return buffer;
 }
 
-// The sweep every scene gets. Parts (a)-(c) of the virtual-light methods are
-// path-sampled, and their noise counts in the image's error like (d)'s: the
-// samples per pixel grow with the number of lights along each curve, as a user
-// buying a better image would do.
 // VPL Lightcuts at e = 0.02 with `distanceSamples` per camera segment.
 MethodRun vplWithDistanceSamples(uint64_t lights, int spp, int distanceSamples) {
     MethodRun r{RenderMethod::VplLightcuts, lights, spp, 0.02f};
@@ -31,6 +27,10 @@ MethodRun vplWithDistanceSamples(uint64_t lights, int spp, int distanceSamples) 
     return r;
 }
 
+// The sweep every scene gets. Parts (a)-(c) of the virtual-light methods are
+// path-sampled, and their noise counts in the image's error like (d)'s: the
+// samples per pixel grow with the number of lights along each curve, as a user
+// buying a better image would do.
 std::vector<MethodRun> sweep(bool quick) {
     std::vector<MethodRun> runs;
     if (quick) {
@@ -124,7 +124,8 @@ std::vector<MethodRun> multipleSweep(bool quick) {
 // before repeats but one (bathroom-hg07's VRL Lightcuts at N = 300, 5.4 s); the
 // whole image's VRL Lightcuts at N = 300, 2 spp (3.2-5.5 s) is not repeated.
 // 53 points. Their two extra renders took the full report from 39.3 to 43.6 min,
-// within its 45-minute limit; more repeats would not fit.
+// within its 45-minute limit. VPL Lightcuts' D=4 points (2-3 s, added after the
+// repeats were chosen) have one render each.
 bool cheapPoint(const MethodRun& r) {
     const bool oneSpp = r.spp == 1;
     if (!r.multipleOnly)
@@ -185,10 +186,16 @@ void checkScene(const BenchmarkScene& s) {
     for (const MethodRun& r : s.runs)
         if (!seen.emplace(r.curve(), r.label()).second)
             throw std::logic_error("benchmark scene " + s.name + " runs " + r.curve() + " " + r.label() + " twice");
-    for (const MethodRun& r : s.runs)
+    for (const MethodRun& r : s.runs) {
         if (r.repeats < 1)
             throw std::logic_error("benchmark scene " + s.name + ": " + r.curve() + " " + r.label() + " has " +
                                    std::to_string(r.repeats) + " renders (at least 1)");
+        if (r.distanceSamples != 0 && (!usesVpls(r.method) || r.distanceSamples < 1 ||
+                                       r.distanceSamples > kMaxVplDistanceSamples))
+            throw std::logic_error("benchmark scene " + s.name + ": " + r.curve() + " " + r.label() +
+                                   ": distance samples are for the VPL methods, 1 to " +
+                                   std::to_string(kMaxVplDistanceSamples) + " (0: the default)");
+    }
     if (s.partReferenceChunks < kReferenceChunks)
         throw std::logic_error("benchmark scene " + s.name + ": partReferenceChunks " +
                                std::to_string(s.partReferenceChunks) + " is below " +
@@ -280,17 +287,13 @@ std::vector<BenchmarkScene> benchmarkScenes(bool quick, const std::filesystem::p
         s.width = width, s.height = height, s.referenceSpp = referenceSpp;
         s.runs = sweep(false);
         // VPL Lightcuts' whole-image runs at 32 distance samples cost 1-2 min each here:
-        // within the 45-minute limit each scene keeps the sweep's first two (D=4 at
-        // N = 100 and N = 1k at 4 spp, 36 s on bathroom), so that the curve spans an
+        // within the 45-minute limit each scene keeps those up to N = 1k (D=4 at
+        // N = 100, and N = 1k at 4 spp, 36 s on bathroom), so that the curve spans an
         // order of magnitude in time and the equal-time comparison reads VRL
         // Lightcuts' curve; part (d) alone, where the paper compares, has all of its points.
-        const auto vplWholeImage = [](const MethodRun& r) {
-            return r.method == RenderMethod::VplLightcuts && !r.multipleOnly;
-        };
-        auto kept = std::find_if(s.runs.begin(), s.runs.end(), vplWholeImage);
-        if (kept != s.runs.end()) kept = std::find_if(std::next(kept), s.runs.end(), vplWholeImage);
-        if (kept != s.runs.end())
-            s.runs.erase(std::remove_if(std::next(kept), s.runs.end(), vplWholeImage), s.runs.end());
+        std::erase_if(s.runs, [](const MethodRun& r) {
+            return r.method == RenderMethod::VplLightcuts && !r.multipleOnly && r.lights > 1000;
+        });
         for (const auto& r : multipleSweep(false)) s.runs.push_back(r);
         s.tableLights = 10000;
         return s;
@@ -301,8 +304,8 @@ std::vector<BenchmarkScene> benchmarkScenes(bool quick, const std::filesystem::p
                            "veach-lamp-mitsuba-bidir/scene.xml", "sigmaS=0.2,sigmaA=0.04", 320, 180, 16384));
     // Its part (d) reference over 80 VRL sets (noise RMSE 3.97e-4) could not judge
     // VRL Lightcuts at N = 10^5, e = 0.02 (RMSE 6.7e-4, 5.4e-4 net of that noise,
-    // below the noise rule's floor of 1.19e-3): 400 sets bring the noise to about
-    // 1.8e-4 (1/sqrt(5)) and the floor to 5.3e-4, under what that run measures.
+    // below the noise rule's floor of 1.19e-3): over 400 sets its noise is 1.36e-4
+    // and the floor 4.07e-4, under what that run measures.
     scenes.back().partReferenceChunks = 40;
     scenes.push_back(paper("volumetric-caustic", "Bitterli's volumetric caustic as it is (smoke-filled box, glass sphere)",
                            "volumetric-caustic/scene_v0.6.xml", "", 256, 256, 4096));

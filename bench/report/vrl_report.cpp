@@ -256,15 +256,20 @@ Image renderReferenceChunk(const BenchmarkScene& s, const Scene& scene, Referenc
     return mean;
 }
 
+// The commit of the source tree, "+changes" after it where tracked files differ
+// from it (what a reference or a check was computed by).
 std::string gitCommit() {
-    const std::string command = "git -C '" + std::string(VRL_SOURCE_DIR) + "' rev-parse --short HEAD 2>/dev/null";
+    const std::string git = "git -C '" + std::string(VRL_SOURCE_DIR) + "' ";
+    const std::string command =
+        git + "rev-parse --short HEAD 2>/dev/null && { " + git + "diff --quiet HEAD -- 2>/dev/null || echo +changes; }";
     std::string out;
     if (FILE* pipe = popen(command.c_str(), "r")) {
         char buffer[64];
         while (std::fgets(buffer, sizeof buffer, pipe)) out += buffer;
         pclose(pipe);
     }
-    while (!out.empty() && (out.back() == '\n' || out.back() == ' ')) out.pop_back();
+    std::erase(out, '\n');
+    while (!out.empty() && out.back() == ' ') out.pop_back();
     return out.empty() ? "unknown" : out;
 }
 
@@ -541,6 +546,12 @@ struct ReferenceCheck {
     bool done() const { return sets > 0; }
 };
 
+// The check's settings: its VRL sets, VRLs per set, samples per pixel, cut size
+// and the seed of set 0 (set k: + k). A stored check is keyed by all of them.
+constexpr int kCheckSets = 16, kCheckSpp = 8;
+constexpr uint64_t kCheckVrls = 10000, kCheckSeedBase = 3000017;
+constexpr uint32_t kCheckCutSize = 32;
+
 ReferenceCheck checkPartReference(const BenchmarkScene& s, const Scene& scene, const Image& reference,
                                   const ReferenceInfo& info, int sets, uint64_t vrls, int spp, const Log& log) {
     ReferenceCheck c;
@@ -551,7 +562,8 @@ ReferenceCheck checkPartReference(const BenchmarkScene& s, const Scene& scene, c
     std::vector<double> sum(n, 0.0), sum2(n, 0.0);
     for (int k = 0; k < sets; ++k) {
         RenderSettings settings =
-            settingsFor(s, MethodRun{RenderMethod::VrlStochastic, vrls, spp, 0.02f, 32}, 3000017 + uint64_t(k));
+            settingsFor(s, MethodRun{RenderMethod::VrlStochastic, vrls, spp, 0.02f, kCheckCutSize},
+                        kCheckSeedBase + uint64_t(k));
         settings.transports = TransportSelection::parse("multiple");
         const Image image = render(scene, settings).image;
         for (size_t i = 0; i < n; ++i) {
@@ -570,8 +582,8 @@ ReferenceCheck checkPartReference(const BenchmarkScene& s, const Scene& scene, c
     c.checkNoiseRmse = std::sqrt(variance / double(n));
     c.expectedRmse = std::sqrt(info.noiseRmse * info.noiseRmse + variance / double(n));
     c.seconds = secondsSince(start);
-    log.line("%s: part (d) reference check: stochastic VRL Lightcuts over %d sets of %llu: RMSE of the difference %.4g, expected "
-             "from the noises %.4g (ratio %.2f)", s.name.c_str(), sets, (unsigned long long)vrls, c.differenceRmse,
+    log.line("%s: part (d) reference check: stochastic VRL Lightcuts K=%u over %d sets of %llu: RMSE of the difference %.4g, expected "
+             "from the noises %.4g (ratio %.2f)", s.name.c_str(), kCheckCutSize, sets, (unsigned long long)vrls, c.differenceRmse,
              c.expectedRmse, c.differenceRmse / c.expectedRmse);
     return c;
 }
@@ -584,25 +596,27 @@ ReferenceCheck checkPartReference(const BenchmarkScene& s, const Scene& scene, c
 // not parse, is said so and replaced.
 ReferenceCheck storedPartReferenceCheck(const BenchmarkScene& s, const Scene& scene, const Image& reference,
                                         const ReferenceInfo& info, const Log& log) {
-    constexpr int kSets = 16, kSpp = 8;
-    constexpr uint64_t kVrls = 10000;
     const fs::path file = fs::path(info.file).replace_extension(".check.txt");
-    const std::string key = "stochastic VRL Lightcuts K=32 sets=" + std::to_string(kSets) + " vrls=" +
-                            std::to_string(kVrls) + " spp=" + std::to_string(kSpp) + " seeds=3000017+set version=" +
-                            VRL_VERSION + " reference=" + info.file.filename().string();
+    const std::string key = "stochastic VRL Lightcuts K=" + std::to_string(kCheckCutSize) + " sets=" +
+                            std::to_string(kCheckSets) + " vrls=" + std::to_string(kCheckVrls) + " spp=" +
+                            std::to_string(kCheckSpp) + " seeds=" + std::to_string(kCheckSeedBase) +
+                            "+set version=" + VRL_VERSION + " reference=" + info.file.filename().string();
     if (fs::exists(file)) {
         std::ifstream in(file);
         std::map<std::string, std::string> fields;
-        for (std::string line; std::getline(in, line);)
+        for (std::string line; std::getline(in, line);) {
+            if (!line.empty() && line.back() == '\r') line.pop_back();  // a CRLF checkout
             if (const size_t colon = line.find(": "); colon != std::string::npos)
                 fields[line.substr(0, colon)] = line.substr(colon + 2);
+        }
         ReferenceCheck c;
-        c.sets = kSets, c.vrls = kVrls, c.spp = kSpp, c.cached = true, c.commit = fields["commit"];
+        c.sets = kCheckSets, c.vrls = kCheckVrls, c.spp = kCheckSpp, c.cached = true;
+        c.commit = fields["commit"].empty() ? "unknown" : fields["commit"];
         const auto number = [&](const char* name, double& value) {
             try {
                 size_t used = 0;
                 value = std::stod(fields.at(name), &used);
-                return used == fields.at(name).size() && std::isfinite(value);
+                return used == fields.at(name).size() && std::isfinite(value) && value > 0.0;
             } catch (const std::exception&) {
                 return false;
             }
@@ -612,7 +626,7 @@ ReferenceCheck storedPartReferenceCheck(const BenchmarkScene& s, const Scene& sc
                      s.name.c_str(), file.filename().c_str(), fields["key"].c_str(), key.c_str());
         else if (!number("difference RMSE", c.differenceRmse) || !number("expected RMSE", c.expectedRmse) ||
                  !number("check noise RMSE", c.checkNoiseRmse) || !number("seconds", c.seconds))
-            log.line("%s: %s lacks a number or does not parse: computing the check again", s.name.c_str(),
+            log.line("%s: %s lacks a positive number or does not parse: computing the check again", s.name.c_str(),
                      file.filename().c_str());
         else {
             log.line("%s: part (d) reference check from the cache (%s): RMSE of the difference %.4g, expected from the "
@@ -621,7 +635,7 @@ ReferenceCheck storedPartReferenceCheck(const BenchmarkScene& s, const Scene& sc
             return c;
         }
     }
-    const ReferenceCheck c = checkPartReference(s, scene, reference, info, kSets, kVrls, kSpp, log);
+    const ReferenceCheck c = checkPartReference(s, scene, reference, info, kCheckSets, kCheckVrls, kCheckSpp, log);
     const fs::path writing = fs::path(file).concat(".writing");
     {
         std::ofstream out(writing);
@@ -963,8 +977,8 @@ void writeComparison(std::ostream& md, const std::vector<RunResult>& results, co
         md << "\n";
     }
     // The same ratios read the other way: at each other method's point, VRL Lightcuts'
-    // curve interpolated. A curve of one or two points (VPL Lightcuts) inside VRL
-    // Lightcuts' time range is compared here, where the table above has no ratio.
+    // curve interpolated. A curve of few points inside VRL Lightcuts' time range
+    // is compared here too, where the table above may have no ratio.
     const auto ourRmse = curveOf(results, name, recommended, false), ourSmape = curveOf(results, name, recommended, true);
     md << "\nThe same ratios at the other methods' points (VRL Lightcuts' curve interpolated at their time or error; "
           "> 1: VRL Lightcuts is better):\n\n| method | point | time (s) | RMSE × | SMAPE × | time × |\n"
@@ -1094,8 +1108,8 @@ void writeSummary(const fs::path& path, const Options& o, const std::vector<Scen
           "with their VRLs: plain VRLs and VRL Lightcuts (relative error threshold e, 0.02 unless stated) once per "
           "pixel, stochastic VRL Lightcuts at every sample (K VRLs per camera segment and surface point). VPL "
           "Lightcuts path-samples part (c) too and gathers (d) without clamping, as in the paper, at 32 stratified "
-          "distance samples per camera segment (its cost floor), or D where a label says D=... (`results.csv`: "
-          "distance_samples; `vrl render --distance-samples`). Errors are on luminance; SMAPE uses epsilon 0.01. "
+          "distance samples per camera segment, or D where a label says D=... (fewer: cheaper and noisier; "
+          "`results.csv`: distance_samples; `vrl render --distance-samples`). Errors are on luminance; SMAPE uses epsilon 0.01. "
           "Rays pass through pixel centres; maximum path length 12.\n\n"
           "**Noise rule.** A run whose RMSE is below " << fmt(kNoiseFactor) << "× the reference's own estimated RMSE "
           "cannot be told from the reference's noise: it is marked ‡ in the tables, written with below_noise = 1 in "
@@ -1296,7 +1310,8 @@ int runReport(const Options& o) {
                 // from the whole image's, both Lightcuts at the default threshold and N.
                 const bool tableRun = (run.method == RenderMethod::VrlLightcuts ||
                                        run.method == RenderMethod::VplLightcuts) &&
-                                      run.lights == s.tableLights && run.errorThreshold == 0.02f;
+                                      run.lights == s.tableLights && run.errorThreshold == 0.02f &&
+                                      run.distanceSamples == 0;
                 if (tableRun && run.multipleOnly) {
                     report.tableStats[run.method] = {stats.meanEvaluated, stats.meanIntersected};
                     for (const char* counter : {"eval", "inter"})
@@ -1429,7 +1444,8 @@ int main(int argc, char** argv) {
     app.add_flag("--references", o.buildReferences,
                  "Only build the references that are missing (the whole image by the path tracer, or by light "
                  "tracing to the camera where a scene says so; part (d) by plain VRLs over independent VRL sets; "
-                 "hours), then stop");
+                 "hours) and the missing check of bathroom's part (d) reference (about 2.5 min, stored beside it, "
+                 "outside --reference-minutes), then stop");
     app.add_option("--reference-minutes", o.referenceMinutes,
                    "--references: stop each scene's references after about this many minutes, at least one chunk "
                    "each (0, the default: no limit); the chunks done are kept and a later run resumes them")

@@ -5,8 +5,11 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <map>
 #include <set>
 #include <stdexcept>
+#include <string>
+#include <vector>
 
 using namespace vrl;
 using namespace vrl::report;
@@ -124,7 +127,36 @@ TEST(BenchmarkScenes, AVplRunCanAskForItsDistanceSamples) {
     MethodRun fewer = run;
     fewer.distanceSamples = 4;
     EXPECT_EQ(fewer.label(), "N=100 e=0.02 1 spp D=4");
-    EXPECT_EQ(fewer.curve(), run.curve()) << "the same curve, a cheaper point";
     EXPECT_EQ(runSettings(s, fewer).vplDistanceSamples, 4);
-    EXPECT_NE(fewer.seed(s.name), run.seed(s.name));
+    // Refused where it means nothing or is out of range.
+    BenchmarkScene bad = s;
+    bad.runs = {fewer};
+    EXPECT_NO_THROW(checkScene(bad));
+    for (const int d : {-1, kMaxVplDistanceSamples + 1}) {
+        bad.runs[0].distanceSamples = d;
+        EXPECT_THROW(checkScene(bad), std::logic_error) << d;
+    }
+    bad.runs[0] = {RenderMethod::VrlLightcuts, 100, 1, 0.02f};
+    bad.runs[0].distanceSamples = 4;
+    EXPECT_THROW(checkScene(bad), std::logic_error) << "distance samples on VRL Lightcuts";
+}
+
+TEST(BenchmarkScenes, EveryVplCurveReachesItsCheapEnd) {
+    // Each scene that runs VPL Lightcuts has its D=4 point on every part it runs
+    // it on; the paper's scenes keep the whole image's points up to N = 1k.
+    for (const BenchmarkScene& s : scenes(false)) {
+        std::map<bool, std::vector<std::string>> labels;  // multipleOnly -> labels
+        for (const MethodRun& r : s.runs)
+            if (r.method == RenderMethod::VplLightcuts) labels[r.multipleOnly].push_back(r.label());
+        if (s.name == "bathroom-hg07") {
+            EXPECT_TRUE(labels.empty());
+            continue;
+        }
+        EXPECT_EQ(labels[true], (std::vector<std::string>{"N=100 e=0.02 1 spp D=4", "N=100 e=0.02 1 spp",
+                                                          "N=1k e=0.02 1 spp"}))
+            << s.name;
+        std::vector<std::string> whole = {"N=100 e=0.02 1 spp D=4", "N=1k e=0.02 4 spp"};
+        if (s.name == "bathroom") whole.push_back("N=10k e=0.02 16 spp");
+        EXPECT_EQ(labels[false], whole) << s.name;
+    }
 }

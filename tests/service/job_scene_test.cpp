@@ -162,6 +162,8 @@ TEST(ResolveJob, VplDistanceSamplesComeFromTheSpec) {
     EXPECT_EQ(rpc::resolveJob(scene, spec, {}).settings.vplDistanceSamples, RenderSettings{}.vplDistanceSamples);
     spec.mutable_parameters()->set_vpl_distance_samples(4);
     EXPECT_EQ(rpc::resolveJob(scene, spec, {}).settings.vplDistanceSamples, 4);
+    spec.mutable_parameters()->set_vpl_distance_samples(uint32_t(kMaxVplDistanceSamples));
+    EXPECT_EQ(rpc::resolveJob(scene, spec, {}).settings.vplDistanceSamples, kMaxVplDistanceSamples);
     spec.mutable_parameters()->set_vpl_distance_samples(uint32_t(kMaxVplDistanceSamples) + 1);
     try {
         rpc::validateJobSpec(spec, {});

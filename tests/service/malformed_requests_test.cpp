@@ -287,6 +287,8 @@ void submitJobCases(Harness& h) {
          "partition size"},
         {"partition size 2^32-1", [&](S& s) { params(s).set_partition_size(kU32); }, StatusCode::INVALID_ARGUMENT,
          "partition size"},
+        {"VPL distance samples 2^32-1", [&](S& s) { params(s).set_vpl_distance_samples(kU32); },
+         StatusCode::INVALID_ARGUMENT, "VPL distance samples per camera segment must be in 1...4096"},
         {"tile size 2^32-1", [](S& s) { s.set_tile_size(kU32); }, StatusCode::INVALID_ARGUMENT,
          "tile size 4294967295 exceeds the limit of 256"},
         {"tile size 257", [](S& s) { s.set_tile_size(257); }, StatusCode::INVALID_ARGUMENT, "tile size 257"},
