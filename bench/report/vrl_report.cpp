@@ -27,6 +27,7 @@
 #include "render/scene_io/medium_fill.h"
 #include "render/scene_io/mitsuba/mitsuba_parser.h"
 #include "render/vrl/light_tracer.h"
+#include "util/atomic_file.h"
 #include "util/hash.h"
 
 #include <CLI/CLI.hpp>
@@ -442,8 +443,8 @@ ImageSet referenceSet(const BenchmarkScene& s, const Scene& scene, ReferencePart
         ++done;
         log.line("%s: %s: chunk %d of %d", s.name.c_str(), spec.what.c_str(), done, spec.chunks);
         if (done == spec.chunks) break;
-        // Every chunk is kept (written beside, then renamed: a run killed at any
-        // moment loses at most the chunk it was rendering); a later run resumes.
+        // Every chunk is kept (writeExr replaces the file atomically: a run killed at
+        // any moment loses at most the chunk it was rendering); a later run resumes.
         ImageSet save;
         save.image = halves[0];
         save.layers = {{"half1", halves[0]}, {"half2", halves[1]}};
@@ -452,9 +453,7 @@ ImageSet referenceSet(const BenchmarkScene& s, const Scene& scene, ReferencePart
         save.metadata["vrl.report.seconds"] = seconds + secondsSince(start);
         if (!base.empty()) save.metadata["vrl.report.extends"] = base;
         fs::create_directories(dir);
-        const fs::path writing = fs::path(partial).concat(".writing");
-        writeExr(writing, save);
-        fs::rename(writing, partial);
+        writeExr(partial, save);
         // At the time limit (after at least one chunk, so that every run makes progress): stop.
         if (minutes > 0.0 && secondsSince(start) > 60.0 * minutes) {
             log.line("%s: %s stopped at the time limit after %d of %d chunks (kept in %s; run again to go on)",
@@ -553,16 +552,17 @@ constexpr uint64_t kCheckVrls = 10000, kCheckSeedBase = 3000017;
 constexpr uint32_t kCheckCutSize = 32;
 
 ReferenceCheck checkPartReference(const BenchmarkScene& s, const Scene& scene, const Image& reference,
-                                  const ReferenceInfo& info, int sets, uint64_t vrls, int spp, const Log& log) {
+                                  const ReferenceInfo& info, const Log& log) {
+    const int sets = kCheckSets;
     ReferenceCheck c;
-    c.sets = sets, c.vrls = vrls, c.spp = spp;
+    c.sets = sets, c.vrls = kCheckVrls, c.spp = kCheckSpp;
     c.commit = gitCommit();
     const auto start = Clock::now();
     const size_t n = size_t(s.width) * size_t(s.height);
     std::vector<double> sum(n, 0.0), sum2(n, 0.0);
     for (int k = 0; k < sets; ++k) {
         RenderSettings settings =
-            settingsFor(s, MethodRun{RenderMethod::VrlStochastic, vrls, spp, 0.02f, kCheckCutSize},
+            settingsFor(s, MethodRun{RenderMethod::VrlStochastic, kCheckVrls, kCheckSpp, 0.02f, kCheckCutSize},
                         kCheckSeedBase + uint64_t(k));
         settings.transports = TransportSelection::parse("multiple");
         const Image image = render(scene, settings).image;
@@ -583,7 +583,7 @@ ReferenceCheck checkPartReference(const BenchmarkScene& s, const Scene& scene, c
     c.expectedRmse = std::sqrt(info.noiseRmse * info.noiseRmse + variance / double(n));
     c.seconds = secondsSince(start);
     log.line("%s: part (d) reference check: stochastic VRL Lightcuts K=%u over %d sets of %llu: RMSE of the difference %.4g, expected "
-             "from the noises %.4g (ratio %.2f)", s.name.c_str(), kCheckCutSize, sets, (unsigned long long)vrls, c.differenceRmse,
+             "from the noises %.4g (ratio %.2f)", s.name.c_str(), kCheckCutSize, sets, (unsigned long long)kCheckVrls, c.differenceRmse,
              c.expectedRmse, c.differenceRmse / c.expectedRmse);
     return c;
 }
@@ -635,17 +635,13 @@ ReferenceCheck storedPartReferenceCheck(const BenchmarkScene& s, const Scene& sc
             return c;
         }
     }
-    const ReferenceCheck c = checkPartReference(s, scene, reference, info, kCheckSets, kCheckVrls, kCheckSpp, log);
-    const fs::path writing = fs::path(file).concat(".writing");
-    {
-        std::ofstream out(writing);
-        out << std::setprecision(17) << "part (d) reference check of " << info.file.filename().string()
-            << "\nkey: " << key << "\ncommit: " << c.commit << "\nseconds: " << c.seconds
-            << "\ndifference RMSE: " << c.differenceRmse << "\nexpected RMSE: " << c.expectedRmse
-            << "\ncheck noise RMSE: " << c.checkNoiseRmse << "\n";
-        if (!out) throw std::runtime_error("cannot write " + writing.string());
-    }
-    fs::rename(writing, file);
+    const ReferenceCheck c = checkPartReference(s, scene, reference, info, log);
+    std::ostringstream text;
+    text << std::setprecision(17) << "part (d) reference check of " << info.file.filename().string()
+         << "\nkey: " << key << "\ncommit: " << c.commit << "\nseconds: " << c.seconds
+         << "\ndifference RMSE: " << c.differenceRmse << "\nexpected RMSE: " << c.expectedRmse
+         << "\ncheck noise RMSE: " << c.checkNoiseRmse << "\n";
+    util::writeFileAtomically(file, text.str());
     return c;
 }
 
