@@ -102,7 +102,7 @@ struct RenderSettings {
     int vrlSamples = 1;          // (u, v) samples per VRL and camera segment
     // vrl-lightcuts method
     CutSettings cut;             // error threshold, maximum cut, bound parameters
-    int vplDistanceSamples = 32;  // vpl, vpl-lightcuts: stratified distance samples per camera segment
+    int vplDistanceSamples = kDefaultVplDistanceSamples;  // vpl, vpl-lightcuts: stratified distance samples per camera segment
     uint32_t partitionSize = 2048;  // light tree: VRLs per partition of the median-split phase
     // vrl-stochastic only: independent VRL sets of vrlCount VRLs each (own light-tracing
     // streams, own trees); camera sample s uses set s mod vrlSets, so the image converges

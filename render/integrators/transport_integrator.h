@@ -51,7 +51,7 @@ struct TransportIntegratorSettings {
     CutSettings cut;     // used when a light tree is given
     // The lights are VPLs: (d) is VPL Lightcuts over the tree, or plain VPLs without one.
     bool vpls = false;
-    int vplDistanceSamples = 32;  // distance samples per camera segment (VPLs)
+    int vplDistanceSamples = kDefaultVplDistanceSamples;  // distance samples per camera segment (VPLs)
     // With a tree: (c), (d) by stochastic cuts (stochastic_vrl_cut.h) of cut.stochasticCutSize nodes.
     bool stochastic = false;
 };

@@ -23,6 +23,11 @@ struct ClusterBoundSettings {
     float glossyMargin = 2.0f;         // VRL-lit glossy surfaces: f|cos| towards the box's corners x this
 };
 
+// VPL Lightcuts and plain VPLs: stratified distance samples per camera segment, each
+// one cut (or gather) at a point of the segment. The one default for the renderer
+// (RenderSettings), the integrator and the VPL estimators.
+inline constexpr int kDefaultVplDistanceSamples = 32;
+
 struct CutSettings {
     float errorThreshold = 0.02f;
     uint32_t maxCutSize = 4096;

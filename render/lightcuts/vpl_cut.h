@@ -28,11 +28,9 @@ class Scene;
 
 class VplLightcutsEstimator {
 public:
-    static constexpr int kDefaultDistanceSamples = 32;
-
     // `tree` must be built with LightTreeSettings::points over VPLs (Vrls of length 0).
     VplLightcutsEstimator(const Scene& scene, const LightTree& tree, CutSettings settings,
-                          int distanceSamples = kDefaultDistanceSamples);
+                          int distanceSamples = kDefaultVplDistanceSamples);
 
     // Multiple scattering along `segment` (already multiplied by its throughputBefore).
     Rgb estimate(const CameraSegment& segment, Rng& rng, CutStatistics& statistics) const;
@@ -58,7 +56,7 @@ private:
 class VplEstimator {
 public:
     VplEstimator(const Scene& scene, const std::vector<Vrl>& vpls,
-                 int distanceSamples = VplLightcutsEstimator::kDefaultDistanceSamples);
+                 int distanceSamples = kDefaultVplDistanceSamples);
     Rgb estimate(const CameraSegment& segment, Rng& rng) const;
 
 private:

@@ -436,7 +436,7 @@ TEST(VplLightcuts, SameSeedSameImageOtherSeedOtherImage) {
     EXPECT_GT(stats.vrlCount, 0u);
     EXPECT_EQ(stats.lightPaths, 1000u);
     EXPECT_GT(stats.meanCutSize, 1.0);
-    EXPECT_LT(stats.meanCutSize, double(stats.vrlCount) * VplLightcutsEstimator::kDefaultDistanceSamples);
+    EXPECT_LT(stats.meanCutSize, double(stats.vrlCount) * kDefaultVplDistanceSamples);
 }
 
 }  // namespace
