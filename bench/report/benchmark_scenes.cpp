@@ -128,9 +128,10 @@ std::vector<MethodRun> multipleSweep(bool quick) {
 // (e = 0.1), the stochastic cuts at 1 spp and K = 8 at 4 spp. All took under
 // 3.5 s a render in the report before repeats but one (bathroom-hg07's VRL
 // Lightcuts at N = 300, 5.4 s). 57 points. The two extra renders of the first 53
-// took the full report from 39.3 to 43.6 min, within its 45-minute limit. VPL
-// Lightcuts' D=4 points (2-3 s, added after the repeats were chosen) have one
-// render each: repeating them too would leave the report under a minute of margin.
+// took the full report from 39.3 to 43.6 min; with all 57 it took 43.5 min, within
+// its 45-minute limit. VPL Lightcuts' D=4 points (2-3 s, added after the repeats
+// were chosen) have one render each: two more renders of their 12 points would
+// cost about 50 s and leave the report under a minute of margin.
 bool cheapPoint(const MethodRun& r) {
     const bool oneSpp = r.spp == 1;
     if (!r.multipleOnly)

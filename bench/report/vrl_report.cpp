@@ -1104,7 +1104,8 @@ void writeSummary(const fs::path& path, const Options& o, const std::vector<Scen
           "with their VRLs: plain VRLs and VRL Lightcuts (relative error threshold e, 0.02 unless stated) once per "
           "pixel, stochastic VRL Lightcuts at every sample (K VRLs per camera segment and surface point). VPL "
           "Lightcuts path-samples part (c) too and gathers (d) without clamping, as in the paper, at "
-       << kDefaultVplDistanceSamples << " stratified distance samples per camera segment, or D where a label says D=... (fewer: cheaper and noisier; "
+       << kDefaultVplDistanceSamples
+       << " stratified distance samples per camera segment, or D where a label says D=... (fewer: cheaper and noisier; "
           "`results.csv`: distance_samples; `vrl render --distance-samples`). Errors are on luminance; SMAPE uses epsilon 0.01. "
           "Rays pass through pixel centres; maximum path length 12.\n\n"
           "**Noise rule.** A run whose RMSE is below " << fmt(kNoiseFactor) << "× the reference's own estimated RMSE "
@@ -1197,7 +1198,8 @@ void writeSummary(const fs::path& path, const Options& o, const std::vector<Scen
            << fmt(vpl.second, 4) << " | " << fmt(vrlc.first, 4) << " | " << fmt(vrlc.second, 4) << " | "
            << fmt(s.surfaceStats.first, 4) << " | " << fmt(s.surfaceStats.second, 4) << " |\n";
     }
-    md << "\nVPL counts are summed over the " << kDefaultVplDistanceSamples << " distance samples of each camera segment (one cut each); VRL counts "
+    md << "\nVPL counts are summed over the " << kDefaultVplDistanceSamples
+       << " distance samples of each camera segment (one cut each); VRL counts "
           "are one cut per camera segment; part (c), VRL-lit surfaces, one cut per surface point (VPL Lightcuts "
           "path-sample it).\n\n";
     md << "## Figure 4: speed-up of Lightcuts over brute force\n\n![speed-up](speedup.png)\n\n";
