@@ -124,7 +124,7 @@ void addRenderOptions(CLI::App& cmd, RenderCommandOptions& o) {
     cmd.add_option("--distance-samples", o.distanceSamples,
                    "vpl, vpl-lightcuts: stratified distance samples per camera segment, each gathering the VPLs "
                    "(by a cut for vpl-lightcuts); their cost grows with it, the noise of the distance sampling "
-                   "falls (default " + std::to_string(RenderSettings{}.vplDistanceSamples) + ")")
+                   "falls (default " + std::to_string(kDefaultVplDistanceSamples) + ")")
         ->check(CLI::Range(1u, uint32_t(kMaxVplDistanceSamples)));
     cmd.add_flag("--pixel-centres", o.pixelCentres,
                  "Camera rays through pixel centres, the paper's setting (default: jittered inside each pixel, "

@@ -43,7 +43,7 @@ struct RenderCommandOptions {
     uint32_t partitionSize = 2048;
     uint32_t cutSize = 32;  // vrl-stochastic
     uint32_t vrlSets = 1;   // vrl-stochastic
-    uint32_t distanceSamples = uint32_t(RenderSettings{}.vplDistanceSamples);  // vpl, vpl-lightcuts: per camera segment
+    uint32_t distanceSamples = kDefaultVplDistanceSamples;  // vpl, vpl-lightcuts: per camera segment
     // Distributed rendering (render --workers, submit)
     int workers = 0;       // render: 0 embedded, N: a local coordinator and N worker processes
     uint32_t tileSize = 32;
