@@ -231,6 +231,9 @@ int runRender(const RenderCommandOptions& o, const CLI::App& command) {
             std::fprintf(stderr, "  %d independent VRL sets (counts above are over all of them); sample s uses set s mod %d\n",
                          settings.vrlSets, settings.vrlSets);
         std::fprintf(stderr, "  transport parts: %s\n", settings.transports.toString().c_str());
+        if (usesSurfaceVpls(settings))
+            std::fprintf(stderr, "  (b) surface light from %llu surface VPLs of the same light paths\n",
+                         (unsigned long long)stats.surfaceVplCount);
     }
     if (usesLightTree(settings.method)) {
         std::fprintf(stderr, "  light tree %.3f s, %.1f MiB\n", stats.treeSeconds,
@@ -251,6 +254,9 @@ int runRender(const RenderCommandOptions& o, const CLI::App& command) {
         if (settings.transports.has(TransportPart::MediumSurface) && !usesVpls(settings.method))
             std::fprintf(stderr, "  per pixel, (c) medium-to-surface: #Eval %.1f, #Inter %.1f, cut size %.1f\n",
                          stats.surfaceMeanEvaluated, stats.surfaceMeanIntersected, stats.surfaceMeanCutSize);
+        if (usesSurfaceVpls(settings))
+            std::fprintf(stderr, "  per pixel, (b) surface VPLs: #Eval %.1f, #Inter %.1f, cut size %.1f\n",
+                         stats.surfaceVplMeanEvaluated, stats.surfaceVplMeanIntersected, stats.surfaceVplMeanCutSize);
         std::fprintf(stderr, "  bound exceeded by %llu of %llu cluster estimates (%.4f%%)\n",
                      (unsigned long long)stats.boundExceeded, (unsigned long long)stats.boundedEstimates,
                      stats.boundedEstimates ? 100.0 * double(stats.boundExceeded) / double(stats.boundedEstimates) : 0.0);

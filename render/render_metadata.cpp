@@ -41,6 +41,7 @@ void writeRenderMetadata(const RenderRecord& record, const PerspectiveCamera& ca
         metadata[usesVpls(s.method) ? "vrl.vpls" : "vrl.vrls"] = double(stats.vrlCount);
         metadata["vrl.lightPaths"] = double(stats.lightPaths);
         metadata["vrl.time.lightTracing"] = stats.tracingSeconds;
+        if (usesSurfaceVpls(s)) metadata["vrl.surfaceVpls"] = double(stats.surfaceVplCount);
     }
     if (usesVpls(s.method)) metadata["vrl.vplDistanceSamples"] = int32_t(s.vplDistanceSamples);
     if (usesLightTree(s.method)) {
@@ -71,6 +72,11 @@ void writeRenderMetadata(const RenderRecord& record, const PerspectiveCamera& ca
             else
                 metadata["vrl.surface.meanInter"] = stats.surfaceMeanIntersected;
             metadata["vrl.surface.meanCut"] = stats.surfaceMeanCutSize;
+        }
+        if (usesSurfaceVpls(s)) {
+            metadata["vrl.surfaceVpl.meanEval"] = stats.surfaceVplMeanEvaluated;
+            metadata["vrl.surfaceVpl.meanInter"] = stats.surfaceVplMeanIntersected;
+            metadata["vrl.surfaceVpl.meanCut"] = stats.surfaceVplMeanCutSize;
         }
         if (!stochastic) {
             metadata["vrl.boundExceeded"] = double(stats.boundExceeded);

@@ -29,6 +29,8 @@ constexpr const char* kSurfaceCutLayerNames[3] = {"medium-surface-eval", "medium
 constexpr const char* kStochasticLayerNames[3] = {"eval", "importance", "cut"};
 constexpr const char* kSurfaceStochasticLayerNames[3] = {"medium-surface-eval", "medium-surface-importance",
                                                          "medium-surface-cut"};
+// vrl-lightcuts: the cut over surface VPLs (part (b)'s surface light), per pixel, over its camera segments.
+constexpr const char* kSurfaceVplCutLayerNames[3] = {"single-vpl-eval", "single-vpl-inter", "single-vpl-cut"};
 
 // The ray of image pixel (x, y): through its film pixel, so a crop shades what the full film would.
 Ray cameraRay(const PerspectiveCamera& camera, const RenderSettings& settings, int x, int y, Rng& rng) {
@@ -44,12 +46,20 @@ bool vrlLitSurfaces(const RenderSettings& settings) {
     return isVrlMethod(settings) && !usesVpls(settings.method) && settings.transports.has(TransportPart::MediumSurface);
 }
 
-// The virtual lights are traced: part (d), or part (c) by VRLs, is selected.
-bool needsLights(const RenderSettings& settings) {
+// The VRLs are needed: part (d), or part (c) by VRLs, is selected.
+bool needsVrls(const RenderSettings& settings) {
     return isVrlMethod(settings) && (settings.transports.has(TransportPart::Multiple) || vrlLitSurfaces(settings));
 }
 
+// Light paths are traced: for VRLs or surface VPLs.
+bool needsLights(const RenderSettings& settings) { return needsVrls(settings) || usesSurfaceVpls(settings); }
+
 }  // namespace
+
+bool usesSurfaceVpls(const RenderSettings& settings) {
+    return (settings.method == RenderMethod::Vrl || settings.method == RenderMethod::VrlLightcuts) &&
+           settings.transports.has(TransportPart::Single);
+}
 
 std::string_view methodName(RenderMethod method) {
     switch (method) {
@@ -124,6 +134,7 @@ RenderLights prepareLights(const Scene& scene, const RenderSettings& settings, c
         tracing.maxDepth = settings.maxDepth;
         tracing.seed = k == 0 ? firstSeed : Rng::combine(firstSeed, uint64_t(k));  // set 0: as with one set
         if (points) tracing.deposit = LightDeposit::Points;
+        tracing.surfaceVpls = k == 0 && usesSurfaceVpls(settings);
         const std::string tracingPhase = sets == 1 ? std::string("light tracing")
                                                    : "light tracing (set " + std::to_string(k + 1) + " of " +
                                                          std::to_string(sets) + ")";
@@ -134,6 +145,22 @@ RenderLights prepareLights(const Scene& scene, const RenderSettings& settings, c
         stats.lightPaths += set.lightPaths;
         stats.vrlBytes += set.memoryBytes();
         stats.tracingSeconds += set.tracingSeconds;
+        if (tracing.surfaceVpls) {
+            // Plain and cut shading take the same list (prepareSurfaceVpls); the cut also its tree.
+            const bool cut = usesLightTree(settings.method);
+            const auto treeStart = std::chrono::steady_clock::now();
+            lights.surfaceVpls = prepareSurfaceVpls(scene, std::move(set.surfaceVpls), cut,
+                                                    LightTreeSettings{settings.partitionSize, settings.seed});
+            if (cut) stats.treeSeconds += secondsSince(treeStart);
+            stats.surfaceVplCount = lights.surfaceVpls.vpls.size();
+            stats.treeBytes += lights.surfaceVpls.tree.memoryBytes();
+            set.surfaceVpls = {};
+        }
+        if (!needsVrls(settings)) {  // only part (b)'s surface VPLs: no VRLs kept, no VRL tree
+            lights.vrls.lightPaths = set.lightPaths;
+            lights.vrls.tracingSeconds = set.tracingSeconds;
+            continue;
+        }
         if (!usesLightTree(settings.method) || set.vrls.empty()) {
             // Without a tree there is one set (validateRenderSettings); an empty set keeps its place.
             if (k == 0)
@@ -176,6 +203,14 @@ uint64_t estimateLightMemoryBytes(const RenderSettings& settings) {
     if (settings.method == RenderMethod::VrlStochastic)
         perLight += double(VrlImportance::kBytesPerInnerNode);
     if (settings.method == RenderMethod::Vrl) perLight += double(VrlLanes::kBytesPerVrl);
+    // Surface VPLs (part (b)): counted as one per VRL (a light path meets about as many
+    // surfaces as it leaves segments in a medium that fills the scene), twice while
+    // traced, and for the cut its proxies, nodes and build scratch.
+    if (usesSurfaceVpls(settings)) {
+        perLight += 2.0 * sizeof(SurfaceVpl);
+        if (usesLightTree(settings.method))
+            perLight += sizeof(Vrl) + 2.0 * sizeof(LightTreeNode) + double(LightTree::buildScratchBytesPerVrl());
+    }
     const double bytes = perLight * double(settings.vrlCount) * double(std::max(1, settings.vrlSets));
     return bytes >= 1.8e19 ? ~uint64_t(0) : uint64_t(bytes);
 }
@@ -195,12 +230,15 @@ std::vector<std::string> renderLayerNames(const RenderSettings& settings) {
     if (!isVrlMethod(settings)) return names;
     for (size_t p = 0; p < kTransportPartNames.size(); ++p)
         if (settings.transports.enabled[p]) names.emplace_back(kTransportPartNames[p]);
+    if (usesSurfaceVpls(settings)) names.emplace_back(kSurfaceVplLayerName);
     if (usesLightTree(settings.method)) {
         const bool stochastic = settings.method == RenderMethod::VrlStochastic;
         for (const char* name : stochastic ? kStochasticLayerNames : kCutLayerNames) names.emplace_back(name);
         if (vrlLitSurfaces(settings))
             for (const char* name : stochastic ? kSurfaceStochasticLayerNames : kSurfaceCutLayerNames)
                 names.emplace_back(name);
+        if (usesSurfaceVpls(settings))
+            for (const char* name : kSurfaceVplCutLayerNames) names.emplace_back(name);
     }
     return names;
 }
@@ -228,6 +266,18 @@ void checkLightsMatchScene(const Scene& scene, const RenderLights& lights) {
     };
     checkTree(lights.tree);
     for (const LightTree& tree : lights.moreTrees) checkTree(tree);
+    const SurfaceVplLights& surface = lights.surfaceVpls;
+    for (size_t k = 0; k < surface.vpls.size(); ++k) {
+        const SurfaceVpl& vpl = surface.vpls[k];
+        if (vpl.shape >= scene.shapes().size() || vpl.medium < -1 || vpl.medium >= int32_t(media))
+            throw std::invalid_argument("surface VPL " + std::to_string(k) + " lies on shape " +
+                                        std::to_string(vpl.shape) + " in medium " + std::to_string(vpl.medium) +
+                                        " but the scene has " + std::to_string(scene.shapes().size()) + " shapes and " +
+                                        std::to_string(media) + " media: the lights do not belong to this scene");
+    }
+    if (!surface.tree.empty() && surface.tree.vrls().size() != surface.vpls.size())
+        throw std::invalid_argument("the surface VPL tree holds " + std::to_string(surface.tree.vrls().size()) +
+                                    " lights but the list " + std::to_string(surface.vpls.size()));
 }
 
 }  // namespace
@@ -243,7 +293,8 @@ TileShader::TileShader(const Scene& scene, const RenderSettings& settings, const
         integratorSettings.vplDistanceSamples = settings.vplDistanceSamples;
         integratorSettings.stochastic = settings.method == RenderMethod::VrlStochastic;
         integrator_ = std::make_unique<TransportIntegrator>(scene, lights.vrls, integratorSettings,
-                                                      lightcuts && lights.tree.root() >= 0 ? &lights.tree : nullptr);
+                                                      lightcuts && lights.tree.root() >= 0 ? &lights.tree : nullptr,
+                                                      usesSurfaceVpls(settings) ? &lights.surfaceVpls : nullptr);
         lightsPerSample_ = integrator_->virtualLightsPerSample();
         // Sets 1 ... P-1 (vrl-stochastic): each set's tree, or none when its light tracing found no VRL.
         if (lights.moreTrees.size() + 1 != size_t(settings.vrlSets) && (lights.tree.root() >= 0 || !lights.moreTrees.empty()))
@@ -290,16 +341,18 @@ using PixelValues = std::vector<Rgb>;
 // The cut counters of one evaluation, as layer values.
 // `add`: per camera sample (stochastic cuts), whose middle counter is the
 // importances computed (kStochasticLayerNames) rather than #Inter.
+// `surface`: part (c)'s counters follow; `surfaceVpl`: then the surface-VPL cut's (never with `add`).
 void writeCounters(PixelValues& values, size_t& layer, const CutStatistics& cut, const CutStatistics& surfaceCut,
-                   bool add) {
+                   bool add, bool surface, const CutStatistics* surfaceVplCut = nullptr) {
     const auto put = [&](uint64_t count) {
         Rgb& v = values[layer++];
         v = add ? v + Rgb(float(count)) : Rgb(float(count));
     };
     put(cut.evaluated), put(add ? cut.importanceEvaluations : cut.intersected), put(cut.cutSize);
-    if (layer < values.size())
+    if (surface)
         put(surfaceCut.evaluated), put(add ? surfaceCut.importanceEvaluations : surfaceCut.intersected),
             put(surfaceCut.cutSize);
+    if (surfaceVplCut) put(surfaceVplCut->evaluated), put(surfaceVplCut->intersected), put(surfaceVplCut->cutSize);
 }
 
 }  // namespace
@@ -356,7 +409,9 @@ TileSums TileShader::shadeTile(const TileRect& tile, int firstPass, int passCoun
                     size_t layer = 1;
                     for (size_t part = 0; part < parts.size(); ++part)
                         if (settings_.transports.enabled[part]) pass[layer++] += parts[part];
-                    if (lightcuts && lightsPerSample_) writeCounters(pass, layer, cut, surfaceCut, true);
+                    if (lightcuts && lightsPerSample_)
+                        writeCounters(pass, layer, cut, surfaceCut, true, integrator_->vrlLitSurfaces() &&
+                                                                             settings_.transports.has(TransportPart::MediumSurface));
                 }
                 // The canonical fold: the first pass's sums as they are, later ones added (per-sample layers only).
                 for (size_t l = 0; l < layerCount; ++l)
@@ -366,8 +421,9 @@ TileSums TileShader::shadeTile(const TileRect& tile, int firstPass, int passCoun
                 // VRL, not per camera sample. (c)'s cut measures its error against sample 0's other parts.
                 Rng rng(settings_.seed, Rng::combine(pixel, kPixelLightsSample));
                 const Ray ray = cameraRay(camera, settings_, x, y, rng);
-                CutStatistics cut, surfaceCut;
-                const auto lit = integrator_->virtualLightParts(ray, rng, &cut, &surfaceCut, firstSampleLuminance);
+                CutStatistics cut, surfaceCut, surfaceVplCut;
+                const auto lit =
+                    integrator_->virtualLightParts(ray, rng, &cut, &surfaceCut, firstSampleLuminance, &surfaceVplCut);
                 size_t layer = 1;
                 for (size_t part = 0; part < 4; ++part) {
                     if (!settings_.transports.enabled[part]) continue;
@@ -376,10 +432,15 @@ TileSums TileShader::shadeTile(const TileRect& tile, int firstPass, int passCoun
                         total[layer] = lit.mediumSurface;
                     ++layer;
                 }
+                const bool surfaceVpls = integrator_->surfaceVplsLight();
+                if (surfaceVpls) total[layer++] = lit.singleSurface;
                 if (lightcuts) {
-                    writeCounters(total, layer, cut, surfaceCut, false);
-                    out.sums.boundExceeded += cut.boundExceeded + surfaceCut.boundExceeded;
-                    out.sums.boundedEstimates += cut.boundedEstimates + surfaceCut.boundedEstimates;
+                    writeCounters(total, layer, cut, surfaceCut, false,
+                                  integrator_->vrlLitSurfaces() && settings_.transports.has(TransportPart::MediumSurface),
+                                  surfaceVpls ? &surfaceVplCut : nullptr);
+                    out.sums.boundExceeded += cut.boundExceeded + surfaceCut.boundExceeded + surfaceVplCut.boundExceeded;
+                    out.sums.boundedEstimates +=
+                        cut.boundedEstimates + surfaceCut.boundedEstimates + surfaceVplCut.boundedEstimates;
                 }
             }
             for (size_t l = 0; l < layerCount; ++l) out.sums.layers[l].at(x - tile.x0, y - tile.y0) = total[l];
@@ -407,6 +468,9 @@ ImageSet assembleImageSet(std::vector<Image> layers, const std::vector<std::stri
             if (name == kSurfaceCutLayerNames[2]) statistics->surfaceMeanCutSize = mean;
             if (name == kStochasticLayerNames[1]) statistics->meanImportance = mean;
             if (name == kSurfaceStochasticLayerNames[1]) statistics->surfaceMeanImportance = mean;
+            if (name == kSurfaceVplCutLayerNames[0]) statistics->surfaceVplMeanEvaluated = mean;
+            if (name == kSurfaceVplCutLayerNames[1]) statistics->surfaceVplMeanIntersected = mean;
+            if (name == kSurfaceVplCutLayerNames[2]) statistics->surfaceVplMeanCutSize = mean;
         }
         result.layers.emplace_back(name, std::move(layers[l + 1]));
         for (const char* counter : kCutLayerNames)
@@ -416,6 +480,8 @@ ImageSet assembleImageSet(std::vector<Image> layers, const std::vector<std::stri
         for (const char* counter : kStochasticLayerNames)
             if (name == counter) result.singleChannelLayers.insert(name);
         for (const char* counter : kSurfaceStochasticLayerNames)
+            if (name == counter) result.singleChannelLayers.insert(name);
+        for (const char* counter : kSurfaceVplCutLayerNames)
             if (name == counter) result.singleChannelLayers.insert(name);
     }
     return result;

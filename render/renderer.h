@@ -13,6 +13,7 @@
 #include "render/image/image.h"
 #include "render/integrators/transport_parts.h"
 #include "render/lightcuts/light_tree.h"
+#include "render/lightcuts/surface_vpl_cut.h"
 #include "render/lightcuts/vrl_cut.h"
 #include "render/sample_passes.h"
 #include "render/sample_sums.h"
@@ -128,6 +129,8 @@ struct RenderStatistics {
     double meanEvaluated = 0.0, meanIntersected = 0.0, meanCutSize = 0.0;  // per pixel, part (d)
     double surfaceMeanEvaluated = 0.0, surfaceMeanIntersected = 0.0, surfaceMeanCutSize = 0.0;  // part (c)
     double meanImportance = 0.0, surfaceMeanImportance = 0.0;  // vrl-stochastic: importances per pixel and sample
+    uint64_t surfaceVplCount = 0;  // surface VPLs (part (b)), over the kept ones
+    double surfaceVplMeanEvaluated = 0.0, surfaceVplMeanIntersected = 0.0, surfaceVplMeanCutSize = 0.0;  // their cut
     uint64_t boundExceeded = 0, boundedEstimates = 0;  // inner-node estimates above their bound, (c) and (d)
 };
 
@@ -145,11 +148,18 @@ void validateRenderSettings(const RenderSettings& settings);
 // the VRLs of the `vrl` method, or the light tree of `vrl-lightcuts` (which owns
 // its VRLs). Empty for the path tracer and when neither part (c) nor (d) is selected.
 // vrl-stochastic with vrlSets P > 1: `tree` is set 0's and moreTrees sets 1 ... P-1.
+// Surface VPLs (part (b)'s surface light, vrl and vrl-lightcuts): `surfaceVpls`,
+// with its own tree for vrl-lightcuts (surface_vpl_cut.h).
 struct RenderLights {
     VrlSet vrls;
     LightTree tree;
     std::vector<LightTree> moreTrees;
+    SurfaceVplLights surfaceVpls;
 };
+
+// Whether `settings` take part (b)'s surface light from surface VPLs: vrl and
+// vrl-lightcuts with part (b) selected.
+bool usesSurfaceVpls(const RenderSettings& settings);
 RenderLights prepareLights(const Scene& scene, const RenderSettings& settings, const ProgressCallback& progress = {},
                            RenderStatistics* statistics = nullptr);
 

@@ -10,7 +10,8 @@ namespace vrl {
 namespace {
 
 bool isTransportPart(const std::string& name) {
-    return std::find(kTransportPartNames.begin(), kTransportPartNames.end(), name) != kTransportPartNames.end();
+    return std::find(kTransportPartNames.begin(), kTransportPartNames.end(), name) != kTransportPartNames.end() ||
+           name == kSurfaceVplLayerName;
 }
 
 void checkSameShape(const SampleSums& a, const SampleSums& b) {

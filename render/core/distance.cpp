@@ -91,4 +91,58 @@ std::pair<double, double> signedDistanceRange(const Imath::Box3f& box, const Vec
     return {centre - radius, centre + radius};
 }
 
+SegmentBoxDistances distancesSegmentBox(const Vec3& origin, const Vec3& direction, double length,
+                                        const Imath::Box3f& box) {
+    constexpr double kInf = std::numeric_limits<double>::infinity();
+    if (box.isEmpty()) return {kInf, kInf};
+    // Slab crossings: where a coordinate of the line meets a face plane.
+    double breaks[6];
+    int count = 0;
+    for (int axis = 0; axis < 3; ++axis) {
+        const double d = direction[axis];
+        if (d == 0.0) continue;
+        breaks[count++] = (double(box.min[axis]) - double(origin[axis])) / d;
+        breaks[count++] = (double(box.max[axis]) - double(origin[axis])) / d;
+    }
+    std::sort(breaks, breaks + count);
+    // The squared distance on the piece containing t: sum over axes of (outside gap)^2,
+    // each gap linear in t on the piece: A t^2 + B t + C.
+    const auto pieceMinimum = [&](double a, double b) {  // min over [a, b] of the piece around (a + b) / 2
+        const double mid = std::isfinite(a) && std::isfinite(b) ? 0.5 * (a + b) : std::isfinite(a) ? a + 1.0 : b - 1.0;
+        double A = 0.0, B = 0.0, C = 0.0;
+        for (int axis = 0; axis < 3; ++axis) {
+            const double o = origin[axis], d = direction[axis], lo = box.min[axis], hi = box.max[axis];
+            const double x = o + mid * d;
+            double p0, p1;  // gap = p0 + p1 t
+            if (x < lo) p0 = lo - o, p1 = -d;
+            else if (x > hi) p0 = o - hi, p1 = d;
+            else continue;
+            A += p1 * p1, B += 2.0 * p0 * p1, C += p0 * p0;
+        }
+        const auto value = [&](double t) { return std::max(0.0, (A * t + B) * t + C); };
+        double best = kInf;
+        if (std::isfinite(a)) best = std::min(best, value(a));
+        if (std::isfinite(b)) best = std::min(best, value(b));
+        if (A > 0.0) {
+            const double t = -B / (2.0 * A);
+            if (t >= a && t <= b) best = std::min(best, value(t));
+        } else if (!std::isfinite(a) || !std::isfinite(b)) {
+            best = std::min(best, C);  // constant on an unbounded piece (B = 0 when A = 0)
+        }
+        return best;
+    };
+    double line = kInf, segment = kInf;
+    double from = -kInf;
+    for (int k = 0; k <= count; ++k) {
+        const double to = k < count ? breaks[k] : kInf;
+        if (to >= from) {
+            line = std::min(line, pieceMinimum(from, to));
+            const double a = std::max(from, 0.0), b = std::min(to, length);
+            if (a <= b) segment = std::min(segment, pieceMinimum(a, b));
+        }
+        from = to;
+    }
+    return {std::sqrt(segment), std::sqrt(line)};
+}
+
 }  // namespace vrl

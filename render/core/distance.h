@@ -18,6 +18,15 @@ double maxSubtendedAngle(double segmentLength, double h);
 // Distance between the infinite line (origin, unit direction) and a box / a segment [a, b].
 double distanceLineBox(const Vec3& origin, const Vec3& direction, const Imath::Box3f& box);
 double distanceLineSegment(const Vec3& origin, const Vec3& direction, const Vec3& a, const Vec3& b);
+// Distances from a box to the segment [origin, origin + length direction] and to
+// its whole line, exactly: the squared distance to the box is a convex piecewise
+// quadratic in the line's parameter (one piece between consecutive slab
+// crossings), minimised piece by piece. Infinite for an empty box.
+struct SegmentBoxDistances {
+    double segment = 0.0, line = 0.0;
+};
+SegmentBoxDistances distancesSegmentBox(const Vec3& origin, const Vec3& direction, double length,
+                                        const Imath::Box3f& box);
 // Distance from a point to a box (0 inside it).
 double distancePointBox(const Vec3& point, const Imath::Box3f& box);
 // Smallest and largest of n.(q - x) over the points q of the box (n need not be

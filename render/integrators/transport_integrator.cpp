@@ -7,14 +7,21 @@
 namespace vrl {
 
 TransportIntegrator::TransportIntegrator(const Scene& scene, const VrlSet& vrls, const TransportIntegratorSettings& settings,
-                             const LightTree* tree)
+                             const LightTree* tree, const SurfaceVplLights* surfaceVpls)
     : scene_(scene),
       vrls_(vrls),
       settings_(settings),
       tracer_(scene, PathTracerSettings{settings.maxDepth}),
       estimator_(scene, settings.vrlSamples),
       surfaceEstimator_(scene, settings.vrlSamples),
-      tree_(tree) {
+      tree_(tree),
+      surfaceVplEstimator_(scene) {
+    if (surfaceVpls && settings.transports.has(TransportPart::Single) && !settings.vpls && !settings.stochastic) {
+        surfaceVpls_ = surfaceVpls;
+        if (!surfaceVpls->tree.empty())
+            surfaceVplLightcuts_ = std::make_unique<SurfaceVplLightcutsEstimator>(scene, *surfaceVpls,
+                                                                                  surfaceVplEstimator_, settings.cut);
+    }
     if (settings.vpls && tree_)
         vplLightcuts_ = std::make_unique<VplLightcutsEstimator>(scene, *tree_, settings.cut, settings.vplDistanceSamples);
     else if (settings.vpls)
@@ -37,8 +44,8 @@ TransportIntegrator::TransportIntegrator(const Scene& scene, const VrlSet& vrls,
     if (settings.maxDepth >= 0 && settings.maxDepth < 16 && scene.hasSpecularSurfaces() &&
         (settings.transports.has(TransportPart::Multiple) ||
          (!settings.vpls && settings.transports.has(TransportPart::MediumSurface))))
-        spdlog::warn("maxDepth {} with specular surfaces: the VRL parts (c), (d) seen through glass or mirrors "
-                     "do not count the specular bounces towards maxDepth", settings.maxDepth);
+        spdlog::warn("maxDepth {} with specular surfaces: the VRL parts (c), (d) (and (b)'s surface VPLs) seen "
+                     "through glass or mirrors do not count the specular bounces towards maxDepth", settings.maxDepth);
 }
 
 std::array<Rgb, 4> TransportIntegrator::samplePathParts(const Ray& cameraRay, Rng& rng) const {
@@ -102,8 +109,12 @@ Rgb TransportIntegrator::mediumToSurface(const CameraSegment& segment, Rng& rng)
     const Vec3 x = segment.origin + segment.direction * float(u);
     const PhaseSample next = medium.phase().sample(segment.direction, Vec2(rng.next(), rng.next()));
     // Exact transmittance to the next surface, reflected light only: a path that
-    // scatters again in the medium first belongs to (d), emission at the surface to (b).
-    const Rgb reflected = tracer_.radiance(Ray{x, next.direction}, segment.medium, rng, PathStart{1 + segment.specularBefore, true, false});
+    // scatters again in the medium first belongs to (d), emission at the surface to
+    // (b)'s single scattering. With surface VPLs, only what leaves that surface by a
+    // Dirac lobe: the VPLs bring the rest (virtualLightParts).
+    PathStart start{1 + segment.specularBefore, true, false};
+    start.diracAtFirstSurfaceOnly = surfaceVpls_ != nullptr;
+    const Rgb reflected = tracer_.radiance(Ray{x, next.direction}, segment.medium, rng, start);
     return segment.throughputBefore * medium.transmittance(float(u)) * medium.sigmaS() * reflected *
            float(1.0 / pdf);
 }
@@ -111,11 +122,12 @@ Rgb TransportIntegrator::mediumToSurface(const CameraSegment& segment, Rng& rng)
 TransportIntegrator::VirtualLightParts TransportIntegrator::virtualLightParts(const Ray& cameraRay, Rng& rng,
                                                                            CutStatistics* multipleStatistics,
                                                                            CutStatistics* surfaceStatistics,
-                                                                           float pathLuminance) const {
+                                                                           float pathLuminance,
+                                                                           CutStatistics* surfaceVplStatistics) const {
     VirtualLightParts parts;
     const bool multiple = settings_.transports.has(TransportPart::Multiple);
     const bool surface = vrlLitSurfaces() && settings_.transports.has(TransportPart::MediumSurface);
-    if (!multiple && !surface) return parts;
+    if (!multiple && !surface && !surfaceVpls_) return parts;
     CutStatistics unused;
     // One stream family per camera segment (and one for the surface x1); VRL k draws
     // from (key, k) in both plain and Lightcuts shading, so the two differ only by
@@ -147,6 +159,23 @@ TransportIntegrator::VirtualLightParts TransportIntegrator::virtualLightParts(co
         parts.mediumSurface = vrlLitSurface(*path.surface, Rng::combine(pixelKey, ~uint64_t(0)),
                                             surfaceStatistics ? *surfaceStatistics : unused,
                                             pathLuminance + std::max(0.0f, luminance(parts.multiple)));
+    // (b)'s surface light from the VPLs, last: its cut measures its error against the pixel's other parts.
+    if (surfaceVpls_) {
+        const float other = pathLuminance + std::max(0.0f, luminance(parts.multiple)) +
+                            std::max(0.0f, luminance(parts.mediumSurface));
+        CutStatistics& statistics = surfaceVplStatistics ? *surfaceVplStatistics : unused;
+        segmentIndex = 0;
+        for (const CameraSegment& segment : path.segments) {
+            // A stream family apart from (d)'s: (key of segment i) with the top bit set.
+            const uint64_t streamKey = Rng::combine(pixelKey, segmentIndex++ | (uint64_t(1) << 63));
+            if (scene_.media()[segment.medium].isNonScattering()) continue;
+            if (settings_.maxDepth >= 0 && settings_.maxDepth < segment.specularBefore + 3) continue;
+            parts.singleSurface += surfaceVplLightcuts_
+                                       ? surfaceVplLightcuts_->estimate(segment, streamKey, statistics,
+                                                                        other + std::max(0.0f, luminance(parts.singleSurface)))
+                                       : sumOverSurfaceVpls(surfaceVplEstimator_, surfaceVpls_->vpls, segment, streamKey);
+        }
+    }
     return parts;
 }
 

@@ -12,7 +12,12 @@
 //       (a point of the camera segment sampled equiangularly towards a light,
 //       next-event estimation there) plus light reflected by surfaces (a point
 //       sampled in proportion to transmittance, a direction by the phase
-//       function, path-traced from the surface it reaches, no emission there);
+//       function, path-traced from the surface it reaches, no emission there).
+//       With surface VPLs (vrl, vrl-lightcuts: surface_vpl.h), the light that
+//       x2 reflects by a non-Dirac lobe comes instead from every surface VPL,
+//       or a cut over them (surface_vpl_cut.h), against each camera segment,
+//       once per pixel; the path-traced part keeps the Dirac lobes at x2
+//       (PathStart::diracAtFirstSurfaceOnly), the complement;
 //   (c) x1 on a surface, x2 in a medium: VRL-lit surfaces: every VRL
 //       (VrlSurfaceEstimator), a cut through the VRL tree (surface_vrl_cut.h)
 //       or a stochastic cut (stochastic_vrl_cut.h) at x1; the VPL methods
@@ -33,6 +38,7 @@
 #include "render/lightcuts/light_tree.h"
 #include "render/lightcuts/vpl_cut.h"
 #include "render/lightcuts/stochastic_vrl_cut.h"
+#include "render/lightcuts/surface_vpl_cut.h"
 #include "render/lightcuts/surface_vrl_cut.h"
 #include "render/lightcuts/vrl_cut.h"
 #include "render/vrl/vrl.h"
@@ -59,8 +65,10 @@ struct TransportIntegratorSettings {
 class TransportIntegrator {
 public:
     // Parts (c), (d) sum every VRL of `vrls`, or, when `tree` is given, walk Lightcuts over it.
+    // With `surfaceVpls` (and part (b) selected), (b)'s non-Dirac surface light comes from
+    // them: a cut when they hold a tree, else every VPL.
     TransportIntegrator(const Scene& scene, const VrlSet& vrls, const TransportIntegratorSettings& settings,
-                  const LightTree* tree = nullptr);
+                  const LightTree* tree = nullptr, const SurfaceVplLights* surfaceVpls = nullptr);
 
     // The path-sampled parts for one camera ray, one sample each: (a), (b), and
     // for the VPL methods (c). The other entries are zero.
@@ -71,11 +79,16 @@ public:
     // light or a cut, with the cuts' counters. (c)'s cut measures its error against
     // the whole pixel: its own total, (d)'s, and `pathLuminance`, the luminance of
     // the path-sampled parts (a), (b) of the pixel (0: against (c) alone).
+    // singleSurface: (b)'s light from surface VPLs (zero without them).
     struct VirtualLightParts {
-        Rgb mediumSurface{0.0f}, multiple{0.0f};
+        Rgb mediumSurface{0.0f}, multiple{0.0f}, singleSurface{0.0f};
     };
     VirtualLightParts virtualLightParts(const Ray& cameraRay, Rng& rng, CutStatistics* multipleStatistics = nullptr,
-                                        CutStatistics* surfaceStatistics = nullptr, float pathLuminance = 0.0f) const;
+                                        CutStatistics* surfaceStatistics = nullptr, float pathLuminance = 0.0f,
+                                        CutStatistics* surfaceVplStatistics = nullptr) const;
+
+    // Part (b)'s non-Dirac surface light comes from surface VPLs (virtualLightParts' singleSurface).
+    bool surfaceVplsLight() const { return surfaceVpls_ != nullptr; }
 
     // Part (c) is estimated from VRLs (not path-sampled).
     bool vrlLitSurfaces() const { return !settings_.vpls; }
@@ -107,6 +120,9 @@ private:
     std::unique_ptr<StochasticLightcutsEstimator> stochastic_;
     std::unique_ptr<VplLightcutsEstimator> vplLightcuts_;
     std::unique_ptr<VplEstimator> plainVpls_;
+    const SurfaceVplLights* surfaceVpls_ = nullptr;  // set only when part (b) takes its surface light from them
+    SurfaceVplEstimator surfaceVplEstimator_;
+    std::unique_ptr<SurfaceVplLightcutsEstimator> surfaceVplLightcuts_;
 };
 
 }  // namespace vrl

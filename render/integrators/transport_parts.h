@@ -15,6 +15,11 @@ enum class TransportPart { Surface = 0, Single = 1, MediumSurface = 2, Multiple 
 inline constexpr std::array<std::string_view, 4> kTransportPartNames = {"surface", "single", "medium-surface",
                                                                         "multiple"};
 
+// A layer of part (b) beside "single": its light from surface VPLs (surface_vpl.h),
+// once per pixel (vrl, vrl-lightcuts); "single" then holds the rest of (b), per
+// sample. The image is the sum of the four parts' layers and this one.
+inline constexpr std::string_view kSurfaceVplLayerName = "single-vpl";
+
 struct TransportSelection {
     std::array<bool, 4> enabled{true, true, true, true};
 

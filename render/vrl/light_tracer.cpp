@@ -28,7 +28,8 @@ LightPathWalker::LightPathWalker(const Scene& scene, const LightTracingSettings&
 
 // Deposits into `out` (when not null) and calls `visit` (when not null) at the scattering vertices.
 void LightPathWalker::trace(uint64_t index, std::vector<Vrl>* out,
-                            const std::function<void(const LightPathVertex&)>* visit) const {
+                            const std::function<void(const LightPathVertex&)>* visit,
+                            std::vector<SurfaceVpl>* surfaceOut) const {
     const EmitterSampler& sampler = scene_.emitterSampler();
     if (sampler.empty()) return;
     Rng rng(settings_.seed, index);
@@ -145,6 +146,9 @@ void LightPathWalker::trace(uint64_t index, std::vector<Vrl>* out,
         ++vertices;
         if (visit && !shape.bsdf.isPurelySpecular())
             (*visit)(LightPathVertex{hit->position, ray.direction, throughput, medium, &*hit, vertices});
+        if (surfaceOut && !shape.bsdf.isPurelySpecular())
+            surfaceOut->push_back({hit->position, hit->geometricNormal, hit->shadingNormal, hit->uv, hit->shape,
+                                   hit->triangle, hit->scale, ray.direction, throughput, medium});
         const auto sampled = shape.bsdf.sample(hit->shadingPoint(), -ray.direction, Vec2(rng.next(), rng.next()),
                                                rng.next(), TransportMode::Importance);
         if (!sampled || isBlack(sampled->weight)) return;  // Bsdf::sample returns finite weights
@@ -165,6 +169,8 @@ VrlSet traceVrls(const Scene& scene, const LightTracingSettings& settings,
     const LightPathWalker tracer(scene, settings);
     VrlSet result;
     std::vector<std::vector<Vrl>> chunks(kChunksPerBatch);
+    std::vector<std::vector<SurfaceVpl>> surfaceChunks(kChunksPerBatch);
+    const bool surfaceVpls = settings.surfaceVpls && settings.deposit == LightDeposit::Segments;
     uint64_t emptyBatches = 0;
     while (true) {
         const uint64_t remaining = settings.lightPaths > 0 ? settings.lightPaths - result.lightPaths : ~0ULL;
@@ -181,11 +187,15 @@ VrlSet traceVrls(const Scene& scene, const LightTracingSettings& settings,
         const uint64_t first = result.lightPaths;
         tbb::parallel_for(uint64_t(0), kChunksPerBatch, [&](uint64_t c) {
             chunks[c].clear();
+            surfaceChunks[c].clear();
             const uint64_t begin = std::min(batch, c * kPathsPerChunk), end = std::min(batch, (c + 1) * kPathsPerChunk);
-            for (uint64_t i = begin; i < end; ++i) tracer.deposit(first + i, chunks[c]);
+            for (uint64_t i = begin; i < end; ++i)
+                tracer.deposit(first + i, chunks[c], surfaceVpls ? &surfaceChunks[c] : nullptr);
         });
         const size_t before = result.vrls.size();
         for (const auto& chunk : chunks) result.vrls.insert(result.vrls.end(), chunk.begin(), chunk.end());
+        for (const auto& chunk : surfaceChunks)  // in chunk order: the same list on any thread count
+            result.surfaceVpls.insert(result.surfaceVpls.end(), chunk.begin(), chunk.end());
         result.lightPaths += batch;
         if (settings.lightPaths > 0) {
             if (progress) progress(double(result.lightPaths) / double(settings.lightPaths));
@@ -202,7 +212,9 @@ VrlSet traceVrls(const Scene& scene, const LightTracingSettings& settings,
     }
     const float scale = result.lightPaths > 0 ? 1.0f / float(result.lightPaths) : 0.0f;
     for (auto& v : result.vrls) v.flux *= scale;
+    for (auto& v : result.surfaceVpls) v.flux *= scale;
     result.vrls.shrink_to_fit();
+    result.surfaceVpls.shrink_to_fit();
     result.tracingSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     return result;
 }

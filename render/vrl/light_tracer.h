@@ -40,6 +40,13 @@ struct LightTracingSettings {
     int maxDepth = -1;
     uint64_t seed = 0;
     int rouletteDepth = 5;
+    // Also deposit a SurfaceVpl (surface_vpl.h) wherever a path meets a surface
+    // that is not purely specular (Segments only). The paths, their random
+    // numbers and their VRLs are the same either way. A VPL at the path's k-th
+    // scattering vertex makes camera paths of k + 2 segments (to a medium point
+    // x1, then to the camera); like the VRLs, it is kept only where the path
+    // may still continue, which gives k + 2 <= maxDepth.
+    bool surfaceVpls = false;
 };
 
 // Throws std::invalid_argument if both lightPaths and targetVrls are 0.
@@ -80,11 +87,15 @@ public:
     void walk(uint64_t index, const std::function<void(const LightPathVertex&)>& visit) const {
         trace(index, nullptr, &visit);
     }
-    // Appends the VRLs (or VPLs) of path `index` to `out`, flux not yet divided by the path count.
-    void deposit(uint64_t index, std::vector<Vrl>& out) const { trace(index, &out, nullptr); }
+    // Appends the VRLs (or VPLs) of path `index` to `out`, and its surface VPLs to
+    // `surfaceOut` when settings.surfaceVpls, flux not yet divided by the path count.
+    void deposit(uint64_t index, std::vector<Vrl>& out, std::vector<SurfaceVpl>* surfaceOut = nullptr) const {
+        trace(index, &out, nullptr, surfaceOut);
+    }
 
 private:
-    void trace(uint64_t index, std::vector<Vrl>* out, const std::function<void(const LightPathVertex&)>* visit) const;
+    void trace(uint64_t index, std::vector<Vrl>* out, const std::function<void(const LightPathVertex&)>* visit,
+               std::vector<SurfaceVpl>* surfaceOut = nullptr) const;
 
     const Scene& scene_;
     LightTracingSettings settings_;

@@ -12,6 +12,7 @@
 
 #include "render/core/geometry.h"
 #include "render/core/rgb.h"
+#include "render/vrl/surface_vpl.h"
 
 #include <cstdint>
 #include <vector>
@@ -30,9 +31,12 @@ struct Vrl {
 
 struct VrlSet {
     std::vector<Vrl> vrls;
+    // Surface VPLs of the same light paths (LightTracingSettings::surfaceVpls), flux
+    // divided by the path count like the VRLs'; empty unless asked for.
+    std::vector<SurfaceVpl> surfaceVpls;
     uint64_t lightPaths = 0;  // light paths traced (the flux normalisation)
     double tracingSeconds = 0.0;
-    size_t memoryBytes() const { return vrls.capacity() * sizeof(Vrl); }
+    size_t memoryBytes() const { return vrls.capacity() * sizeof(Vrl) + surfaceVpls.capacity() * sizeof(SurfaceVpl); }
 };
 
 }  // namespace vrl

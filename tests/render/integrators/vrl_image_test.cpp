@@ -240,9 +240,10 @@ TEST(VrlImage, LayersAreThePartsAndSumToTheImage) {
     settings.samplesPerPixel = 2;
     settings.vrlCount = 500;
     const ImageSet out = render(*scene, settings);
-    ASSERT_EQ(out.layers.size(), 4u);
-    const char* names[] = {"surface", "single", "medium-surface", "multiple"};
-    for (size_t i = 0; i < 4; ++i) EXPECT_EQ(out.layers[i].first, names[i]);
+    // The four parts, then part (b)'s light from surface VPLs (once per pixel).
+    ASSERT_EQ(out.layers.size(), 5u);
+    const char* names[] = {"surface", "single", "medium-surface", "multiple", "single-vpl"};
+    for (size_t i = 0; i < 5; ++i) EXPECT_EQ(out.layers[i].first, names[i]);
     for (size_t p = 0; p < out.image.pixelCount(); ++p) {
         Rgb sum(0.0f);
         for (const auto& layer : out.layers) sum += layer.second[p];
@@ -253,6 +254,8 @@ TEST(VrlImage, LayersAreThePartsAndSumToTheImage) {
         }
     }
     settings.transports = TransportSelection::parse("single,multiple");
+    EXPECT_EQ(render(*scene, settings).layers.size(), 3u);
+    settings.transports = TransportSelection::parse("surface,multiple");  // no (b): no surface VPLs
     EXPECT_EQ(render(*scene, settings).layers.size(), 2u);
     EXPECT_THROW(TransportSelection::parse("single,bogus"), std::invalid_argument);
 }

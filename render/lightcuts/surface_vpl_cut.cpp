@@ -1,0 +1,168 @@
+#include "render/lightcuts/surface_vpl_cut.h"
+
+#include "render/core/distance.h"
+#include "render/lightcuts/cut_walk.h"
+#include "render/vrl/vrl_estimator.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace vrl {
+
+namespace {
+
+constexpr double kRoundingMargin = 1.001;
+
+}  // namespace
+
+Rgb surfaceVplReflectionBound(const Scene& scene, const SurfaceVpl& vpl) {
+    const SurfaceVplEstimator estimator(scene);
+    if (const std::optional<Rgb> bound = estimator.reflectionBound(vpl)) return *bound;
+    // Glossy lobes: a heuristic (surface_vpl_cut.h).
+    const Bsdf& bsdf = scene.shapes()[vpl.shape].bsdf;
+    const SurfaceHit hit = surfaceHitOf(vpl);
+    const Vec3 wo = -vpl.direction;
+    Vec3 n = vpl.shadingNormal;
+    if (wo.dot(n) < 0.0f) n = -n;
+    const Vec3 mirror = (n * (2.0f * wo.dot(n)) - wo).normalized();
+    Rgb largest(0.0f);
+    for (const Vec3& w : {mirror, n, -mirror, -n}) {
+        const Rgb f = bsdf.eval(hit.shadingPoint(), wo, w, TransportMode::Importance);
+        largest = Rgb(std::max(largest.x, f.x), std::max(largest.y, f.y), std::max(largest.z, f.z));
+    }
+    return largest * 2.0f;
+}
+
+SurfaceVplLights prepareSurfaceVpls(const Scene& scene, std::vector<SurfaceVpl> vpls, bool buildTree,
+                                    const LightTreeSettings& settings) {
+    SurfaceVplLights lights;
+    std::vector<Vrl> proxies;
+    size_t kept = 0;
+    for (size_t k = 0; k < vpls.size(); ++k) {
+        const Rgb intensity = vpls[k].flux * surfaceVplReflectionBound(scene, vpls[k]);
+        if (!(maxComponent(intensity) > 0.0f) || !isFinite(intensity)) continue;
+        vpls[kept++] = vpls[k];
+        if (buildTree) proxies.push_back(Vrl{vpls[k].position, vpls[k].direction, 0.0f, intensity, -1});
+    }
+    vpls.resize(kept);
+    vpls.shrink_to_fit();
+    lights.vpls = std::move(vpls);
+    if (buildTree) {
+        LightTreeSettings points = settings;
+        points.points = true;
+        lights.tree = LightTree::build(std::move(proxies), points);
+    }
+    return lights;
+}
+
+SurfaceVplLightcutsEstimator::SurfaceVplLightcutsEstimator(const Scene& scene, const SurfaceVplLights& lights,
+                                                           const SurfaceVplEstimator& estimator, CutSettings settings)
+    : scene_(scene), lights_(lights), estimator_(estimator), settings_(settings) {
+    const LightTree& tree = lights.tree;
+    if (tree.empty()) return;
+    reflection_.reserve(lights.vpls.size());
+    for (const SurfaceVpl& vpl : lights.vpls) reflection_.push_back(surfaceVplReflectionBound(scene, vpl));
+    const auto& nodes = tree.nodes();
+    normals_.assign(nodes.size(), NormalBound{});
+    // Post-order from the root (children before their parent), without recursion.
+    std::vector<std::pair<int32_t, bool>> stack{{tree.root(), false}};
+    while (!stack.empty()) {
+        const auto [i, childrenDone] = stack.back();
+        stack.pop_back();
+        const LightTreeNode& node = nodes[size_t(i)];
+        if (node.isLeaf()) {
+            const SurfaceVpl& vpl = lights.vpls[node.representative];
+            const bool lambertian = scene.shapes()[vpl.shape].bsdf.lambertianBound(vpl.uv).has_value();
+            normals_[size_t(i)] = NormalBound{vpl.geometricNormal, lambertian ? 0.0f : -1.0f};
+            continue;
+        }
+        if (!childrenDone) {
+            stack.push_back({i, true});
+            stack.push_back({node.left, false});
+            stack.push_back({node.right, false});
+            continue;
+        }
+        const NormalBound& l = normals_[size_t(node.left)];
+        const NormalBound& r = normals_[size_t(node.right)];
+        if (l.spread < 0.0f || r.spread < 0.0f) continue;  // stays "no cosine factor"
+        // |n_k - a_l| <= |n_k - a_r| + |a_r - a_l| for the right child's VPLs.
+        normals_[size_t(i)] = NormalBound{l.axis, std::max(l.spread, r.spread + (r.axis - l.axis).length())};
+    }
+}
+
+Rgb SurfaceVplLightcutsEstimator::bound(int32_t index, const CameraSegment& segment) const {
+    const LightTreeNode& node = lights_.tree.nodes()[size_t(index)];
+    const HomogeneousMedium& medium = scene_.media()[size_t(segment.medium)];
+    // Rounding: distances are computed in double from float boxes; shrink them by a
+    // relative margin of the coordinates' size.
+    const float reach = std::max({std::abs(node.box.min.x), std::abs(node.box.min.y), std::abs(node.box.min.z),
+                                  std::abs(node.box.max.x), std::abs(node.box.max.y), std::abs(node.box.max.z)});
+    const double slack = 8.0 * 0x1p-24 * (double(segment.origin.length()) + reach);
+    const SegmentBoxDistances distances =
+        distancesSegmentBox(segment.origin, segment.direction, double(segment.length), node.box);
+    const double dLine = distances.line - slack, dSegment = distances.segment - slack;
+    double geometry = std::numeric_limits<double>::infinity();
+    if (dLine > 0.0) geometry = std::acos(-1.0) / dLine;
+    if (dSegment > 0.0) geometry = std::min(geometry, double(segment.length) / (dSegment * dSegment));
+    if (!std::isfinite(geometry)) return Rgb(std::numeric_limits<float>::infinity());
+    // The cosine at y (surface_vpl_cut.h), for nodes of Lambertian VPLs with nearly one normal.
+    if (!normals_.empty() && normals_[size_t(index)].spread >= 0.0f && normals_[size_t(index)].spread < 1.0f) {
+        const NormalBound& n = normals_[size_t(index)];
+        const auto [boxLow, boxHigh] = signedDistanceRange(node.box, n.axis, segment.origin);
+        const double along = double(n.axis.dot(segment.direction)) * double(segment.length);
+        const double h = std::max({0.0, std::max(0.0, along) - boxLow, boxHigh - std::min(0.0, along)}) + slack;
+        if (dSegment > 0.0) geometry *= std::min(1.0, h / dSegment + double(n.spread));
+    }
+    const double g = std::abs(double(medium.phase().g()));
+    const double phaseMax = medium.phase().isIsotropic() ? double(kInv4Pi) : double(kInv4Pi) * (1.0 + g) / ((1.0 - g) * (1.0 - g));
+    return node.clusterFlux * medium.sigmaS() * segment.throughputBefore * float(kRoundingMargin * phaseMax * geometry);
+}
+
+Rgb SurfaceVplLightcutsEstimator::estimate(const CameraSegment& segment, uint64_t streamKey, CutStatistics& statistics,
+                                           float otherLuminance) const {
+    const LightTree& tree = lights_.tree;
+    if (tree.empty() || !(segment.length > 0.0f)) return Rgb(0.0f);
+    if (scene_.media()[size_t(segment.medium)].isNonScattering()) return Rgb(0.0f);
+    struct Visitor {
+        const SurfaceVplLightcutsEstimator& self;
+        const CameraSegment& segment;
+        uint64_t streamKey;
+        Rgb leaf(int32_t i) const {
+            const uint32_t k = self.lights_.tree.nodes()[size_t(i)].representative;
+            Rng rng = vrlStream(streamKey, k);
+            return self.estimator_.contribution(self.lights_.vpls[k], segment, rng);
+        }
+        bool bound(int32_t i, Rgb& b) const {
+            b = self.bound(i, segment);
+            return std::isfinite(b.x + b.y + b.z);
+        }
+        Rgb estimate(int32_t i) const {
+            const LightTreeNode& node = self.lights_.tree.nodes()[size_t(i)];
+            const uint32_t k = node.representative;
+            const SurfaceVpl& vpl = self.lights_.vpls[k];
+            // Phi_r I_C / I_r = I_C / F_r where Phi_r > 0, and also where the representative
+            // carries no flux in a channel (a null collision of spectral tracking weighs 0
+            // there): its BSDF bound still scales the cluster's light in that channel.
+            const Rgb& reflection = self.reflection_[k];
+            const auto scaled = [](float cluster, float bound) { return bound > 0.0f ? cluster / bound : 0.0f; };
+            const Rgb flux(scaled(node.clusterFlux.x, reflection.x), scaled(node.clusterFlux.y, reflection.y),
+                           scaled(node.clusterFlux.z, reflection.z));
+            Rng rng = vrlStream(streamKey, k);
+            return self.estimator_.contribution(vpl, flux, segment, rng);
+        }
+    };
+    return walkCut(tree, settings_, statistics, Visitor{*this, segment, streamKey}, otherLuminance);
+}
+
+Rgb sumOverSurfaceVpls(const SurfaceVplEstimator& estimator, const std::vector<SurfaceVpl>& vpls,
+                       const CameraSegment& segment, uint64_t streamKey) {
+    Rgb sum(0.0f);
+    for (uint32_t k = 0; k < vpls.size(); ++k) {
+        Rng rng = vrlStream(streamKey, k);
+        sum += estimator.contribution(vpls[k], segment, rng);
+    }
+    return sum;
+}
+
+}  // namespace vrl

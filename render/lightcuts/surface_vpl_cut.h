@@ -1,0 +1,110 @@
+// Lightcuts over surface VPLs (surface_vpl.h) for a camera segment: part (b)'s
+// medium-then-surface light (SurfaceVplEstimator) by a cut instead of every VPL.
+//
+// The tree is a point-cluster LightTree (LightTreeSettings::points) over proxy
+// lights, one per VPL k at its position, whose "flux" is the VPL's intensity
+// bound I_k = Phi_k (x) F_k, F_k a bound on its BSDF times cosine over every
+// outgoing direction (SurfaceVplEstimator::reflectionBound); node C carries
+// I_C = sum of I_k below. Leaf k is VPL k (the tree keeps the input order, so
+// the VPL list and the proxies share indices).
+//
+// Estimate of a node: its representative VPL r's one-sample estimate with flux
+// I_C / F_r, channel by channel (= Phi_r I_C / I_r where Phi_r > 0; a channel in
+// which r carries no flux still estimates the cluster's): linear in I_C, and
+// exactly VPL r's own estimate at a leaf where F_r > 0 (where F_r = 0 the
+// estimate is 0 either way), cut_walk.h's contract. VPL k draws from
+// vrlStream(streamKey, k) in plain and cut shading alike.
+//
+// Bound (proof). For every VPL k of node C (box B) and any sample t of a
+// segment (o, d, S, medium m, throughput beta), the estimate is
+//   beta T_m(t) sigma_s f_p T_r V Phi_k f_s,k (theta_B - theta_A) / h
+//     <= beta sigma_s f_p,max I_k G,   G = min(S / d_s^2, pi / d_l),
+// because T_m, T_r, V <= 1; f_s,k <= F_k; f_p <= f_p,max (1/4pi isotropic,
+// (1 + |g|) / (4 pi (1 - |g|)^2) for Henyey-Greenstein, its value at cos = +-1);
+// and (theta_B - theta_A)/h = integral_0^S dt / |u(t) - y|^2 is at most S / d_s^2
+// (d_s: distance from y to the segment, bounded below by the distance between B
+// and the segment's bounding box) and at most the whole line's integral pi / h
+// (h >= d_l, the distance from the line to B). A node's estimate is
+// sum-weighted by I_C / I_r, so it is at most beta sigma_s f_p,max I_C G.
+// The cosine at y, where every VPL of the node has a Lambertian bound and their
+// geometric normals n_k lie within eps of one axis a (|n_k - a| <= eps: a floor, a
+// wall): for Lambertian-bounded models f_s = F_k |w.n_g| at most (the importance-mode
+// factor is |w.n_g| |w_in.n_s| / |w_in.n_g|), and at the sampled point u
+//   |n_k.w| = |n_k.(u - y)| / r <= (|a.(u - y)| + eps r) / r <= h / d_s + eps,
+// h the largest |a.(u - y)| over the segment's ends and the box's points (a.u is
+// linear along the segment, a.y over the box) and r >= d_s. So the bound takes
+// the factor min(1, h / d_s + eps): it matters where the segment runs low over a
+// distant patch of floor, which it sees at a grazing angle. (A bound of the
+// integral of |cos| / r^2 would be smaller, but the estimate is one sample: its
+// cosine is the sampled point's, times the whole integral of 1 / r^2.)
+// Proven where every VPL below has a Lambertian BSDF bound (diffuse, smooth
+// plastic); VPLs on glossy surfaces get F_k = 2 x the largest f_s |cos| found
+// towards the mirror direction of w_in and the shading normal, a heuristic
+// (the cut counts estimates above their bound: boundExceeded). A node whose box
+// the segment's line meets (d_l = 0) and whose bounding box the segment's
+// touches has no finite bound: it is refined without an estimate (#Inter).
+//
+// The cut stops when the largest bound is below errorThreshold x (luminance
+// of the running total plus the pixel's other parts), as part (c)'s cut does.
+#pragma once
+
+#include "render/lightcuts/cut_settings.h"
+#include "render/lightcuts/light_tree.h"
+#include "render/vrl/surface_vpl_estimator.h"
+
+#include <cstdint>
+#include <vector>
+
+namespace vrl {
+
+// The surface VPLs of a render in the order the cut's tree indexes them, and that tree.
+struct SurfaceVplLights {
+    std::vector<SurfaceVpl> vpls;
+    LightTree tree;  // over proxies (above); empty for plain shading or without VPLs
+    size_t memoryBytes() const { return vpls.capacity() * sizeof(SurfaceVpl) + tree.memoryBytes(); }
+};
+
+// The intensity bound F_k of VPL k (above): proven for Lambertian-bounded BSDFs, a heuristic otherwise.
+Rgb surfaceVplReflectionBound(const Scene& scene, const SurfaceVpl& vpl);
+
+// Leaves out the VPLs whose bound is zero (they reflect nothing) and, with
+// `buildTree`, builds the cut's tree over the rest; the result's vpls are the
+// kept ones, in the tree's order. Plain and cut shading take the same list, so
+// VPL k has the same random stream in both.
+SurfaceVplLights prepareSurfaceVpls(const Scene& scene, std::vector<SurfaceVpl> vpls, bool buildTree,
+                                    const LightTreeSettings& settings = {});
+
+class SurfaceVplLightcutsEstimator {
+public:
+    // `lights` must hold a tree built by prepareSurfaceVpls for this scene.
+    SurfaceVplLightcutsEstimator(const Scene& scene, const SurfaceVplLights& lights,
+                                 const SurfaceVplEstimator& estimator, CutSettings settings);
+
+    // The medium-then-surface light along `segment` from every VPL, by a cut.
+    Rgb estimate(const CameraSegment& segment, uint64_t streamKey, CutStatistics& statistics,
+                 float otherLuminance = 0.0f) const;
+
+    // The bound above for node `node` and `segment`; infinite where the segment may meet the box.
+    Rgb bound(int32_t node, const CameraSegment& segment) const;
+
+private:
+    // Per node: the axis a of its VPLs' geometric normals and eps (above); eps < 0
+    // where some VPL below has no Lambertian bound (no cosine factor then).
+    struct NormalBound {
+        Vec3 axis;
+        float spread = -1.0f;
+    };
+
+    const Scene& scene_;
+    const SurfaceVplLights& lights_;
+    const SurfaceVplEstimator& estimator_;
+    CutSettings settings_;
+    std::vector<NormalBound> normals_;
+    std::vector<Rgb> reflection_;  // F_k per VPL (surfaceVplReflectionBound), for the representatives' flux
+};
+
+// Plain shading: every VPL of `vpls` against `segment`, VPL k from vrlStream(streamKey, k).
+Rgb sumOverSurfaceVpls(const SurfaceVplEstimator& estimator, const std::vector<SurfaceVpl>& vpls,
+                       const CameraSegment& segment, uint64_t streamKey);
+
+}  // namespace vrl

@@ -1,0 +1,51 @@
+#include "render/vrl/surface_vpl_estimator.h"
+
+#include "render/vrl/vrl_estimator.h"
+
+#include <cmath>
+
+namespace vrl {
+
+Rgb SurfaceVplEstimator::contribution(const SurfaceVpl& vpl, const Rgb& flux, const CameraSegment& segment,
+                                      Rng& rng) const {
+    if (!(segment.length > 0.0f) || segment.medium < 0) return Rgb(0.0f);
+    const HomogeneousMedium& medium = scene_.media()[size_t(segment.medium)];
+    if (medium.isNonScattering()) return Rgb(0.0f);
+    const DistanceSample us = sampleEquiangular(segment.origin, segment.direction, segment.length, vpl.position, rng.next());
+    if (!(us.pdf > 0.0f)) return Rgb(0.0f);
+    const Vec3 u = segment.origin + segment.direction * us.t;
+    const Vec3 toU = u - vpl.position;
+    const float r2 = toU.length2();
+    if (!(r2 > 0.0f) || !std::isfinite(r2)) return Rgb(0.0f);
+    const float r = std::sqrt(r2);
+    const Vec3 w = toU / r;
+    const SurfaceHit hit = surfaceHitOf(vpl);
+    const Bsdf& bsdf = scene_.shapes()[vpl.shape].bsdf;
+    const Rgb f = bsdf.eval(hit.shadingPoint(), -vpl.direction, w, TransportMode::Importance);
+    if (isBlack(f)) return Rgb(0.0f);
+    const float phase = medium.phase().eval(w, -segment.direction);
+    if (!(phase > 0.0f)) return Rgb(0.0f);
+    const int towards = scene_.mediumAfter(hit, w, vpl.medium);
+    // The visibility ray leaves from an offset origin (1e-4 of the triangle's
+    // scale); the transmittance is rescaled from its length to r, T(r) / T(|u - origin|),
+    // which exceeds 1 where u lies closer to the offset origin than to y (u just
+    // above the surface near y): clamping that at 1 biased such points low.
+    const Vec3 origin = Scene::offsetOrigin(hit, w);
+    Rgb between = scene_.transmittance(origin, u, towards);
+    if (towards >= 0 && !isBlack(between))
+        between *= scene_.media()[size_t(towards)].transmittance(r - (u - origin).length());
+    if (isBlack(between)) return Rgb(0.0f);
+    const double scale = double(phase) / (double(r2) * double(us.pdf));
+    return flux * f * between * medium.sigmaS() * medium.transmittance(us.t) * segment.throughputBefore * float(scale);
+}
+
+std::optional<Rgb> SurfaceVplEstimator::reflectionBound(const SurfaceVpl& vpl) const {
+    const std::optional<Rgb> lambertian = scene_.shapes()[vpl.shape].bsdf.lambertianBound(vpl.uv);
+    if (!lambertian) return std::nullopt;
+    const float cosGeometric = std::abs(vpl.direction.dot(vpl.geometricNormal));
+    const float cosShading = std::abs(vpl.direction.dot(vpl.shadingNormal));
+    if (!(cosGeometric > 0.0f)) return Rgb(0.0f);  // a grazing arrival: eval's correction is 0 (safeDiv)
+    return *lambertian * (cosShading / cosGeometric);
+}
+
+}  // namespace vrl
