@@ -53,18 +53,21 @@ PreparedJob JobPreparation::prepare(const Job& job, const ProgressCallback& prog
         if (statistics.treeSeconds > 0.0) phases.emplace_back(kLightTreePhase, statistics.treeSeconds);
     }
     t0 = Clock::now();
+    std::vector<uint8_t> vrlBlob;  // the VRLs' blob, as a job without surface VPLs ships it alone
     if (!lights.moreTrees.empty()) {  // vrl-stochastic with several VRL sets: all their trees in one blob
         std::vector<const LightTree*> trees{&lights.tree};
         for (const LightTree& tree : lights.moreTrees) trees.push_back(&tree);
-        const auto bytes = serializeLightTrees(trees);
-        prepared.lights = std::make_shared<const std::string>(bytes.begin(), bytes.end());
+        vrlBlob = serializeLightTrees(trees);
     } else if (lights.tree.root() >= 0) {
-        const auto bytes = serializeLightTree(lights.tree);
-        prepared.lights = std::make_shared<const std::string>(bytes.begin(), bytes.end());
+        vrlBlob = serializeLightTree(lights.tree);
     } else if (!lights.vrls.vrls.empty()) {
-        const auto bytes = serializeVrlSet(lights.vrls);
-        prepared.lights = std::make_shared<const std::string>(bytes.begin(), bytes.end());
+        vrlBlob = serializeVrlSet(lights.vrls);
     }
+    // Part (b)'s surface VPLs go with them in one blob, even where no VRLs are kept (--transport single).
+    const std::vector<uint8_t> blob = usesSurfaceVpls(scene.settings)
+                                          ? serializeJobLights(vrlBlob, serializeSurfaceVpls(lights.surfaceVpls))
+                                          : std::move(vrlBlob);
+    if (!blob.empty()) prepared.lights = std::make_shared<const std::string>(blob.begin(), blob.end());
     prepared.lightsSha = prepared.lights ? util::sha256Hex(*prepared.lights) : "";
     if (prepared.lights) phases.emplace_back("serialise lights", secondsSince(t0));
     prepared.layerNames = renderLayerNames(scene.settings);

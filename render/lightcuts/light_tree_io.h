@@ -17,9 +17,11 @@
 #pragma once
 
 #include "render/lightcuts/light_tree.h"
+#include "render/lightcuts/surface_vpl_cut.h"
 
 #include <cstddef>
 #include <cstdint>
+#include <span>
 #include <vector>
 
 namespace vrl {
@@ -61,5 +63,37 @@ std::vector<uint8_t> serializeLightTrees(const std::vector<const LightTree*>& tr
 // a count out of range, sizes that do not add up to the blob, a checksum mismatch), and
 // with the tree's index for a tree that deserializeLightTree refuses.
 std::vector<LightTree> deserializeLightTrees(const uint8_t* data, size_t size);
+
+// Part (b)'s surface VPLs and their cut's tree (surface_vpl_cut.h), in the same style:
+//   magic    8 bytes  "VRLSVPLS"
+//   version  u32      kLightTreeFormatVersion
+//   count    u32      number of VPLs K
+//   K x VPL  84 bytes position, geometricNormal, shadingNormal xyz, uv (f32), shape,
+//                     triangle (u32), scale, direction xyz, flux rgb (f32), medium (i32)
+//   hasTree  u32      0: no tree (plain shading, or no VPLs); 1: a tree follows
+//   [size    u64      as u32 low + u32 high, then the tree's serializeLightTree blob]
+//   crc      u32      CRC-32 (zlib) of every byte before it
+std::vector<uint8_t> serializeSurfaceVpls(const SurfaceVplLights& lights);
+// The bit-exact inverse; throws std::runtime_error like deserializeLightTree (wrong magic
+// or version, a size that does not match the counts, a tree flag other than 0 or 1, a
+// checksum mismatch), for a tree that deserializeLightTree refuses (its reason, prefixed),
+// and for a tree that is empty or does not hold exactly K lights (one proxy per VPL).
+SurfaceVplLights deserializeSurfaceVpls(const uint8_t* data, size_t size);
+
+// The one lights blob of a job (JobAssets.lights_sha256) when it has surface VPLs:
+//   magic "VRLLIGHT", version u32 (kLightTreeFormatVersion), primary size u64, surface
+//   size u64 (each as u32 low + u32 high), the primary blob, the surface VPL blob, crc u32.
+// The primary blob is what a job without surface VPLs ships alone, unchanged: a tree, a
+// "VRLTREES" blob or a VRL set; empty where no VRLs are kept (part (b) alone). Jobs
+// without surface VPLs ship their primary blob bare, so their blobs are as before.
+std::vector<uint8_t> serializeJobLights(std::span<const uint8_t> primary, std::span<const uint8_t> surfaceVpls);
+struct JobLightsParts {
+    std::span<const uint8_t> primary;      // empty: none
+    std::span<const uint8_t> surfaceVpls;  // empty: none
+};
+// Splits a "VRLLIGHT" blob into views of its two parts (into `data`, which must
+// outlive them); checks its magic, version, sizes and checksum, not the parts.
+// Throws std::runtime_error like deserializeLightTree.
+JobLightsParts parseJobLights(const uint8_t* data, size_t size);
 
 }  // namespace vrl

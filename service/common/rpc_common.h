@@ -19,7 +19,7 @@
 
 namespace vrl::rpc {
 
-inline constexpr uint32_t kProtocolVersion = 5;          // vrl.v1 ProtocolVersion CURRENT
+inline constexpr uint32_t kProtocolVersion = 6;          // vrl.v1 ProtocolVersion CURRENT
 inline constexpr size_t kChunkBytes = 1 << 20;           // streamed blobs: at most 1 MiB per message
 inline constexpr int kMaxMessageBytes = 64 << 20;        // a tile result of 64 MiB at most (e.g. 256x256 x 8 layers)
 inline constexpr std::chrono::milliseconds kKeepaliveTime{20000};

@@ -70,6 +70,16 @@ void expectBitIdentical(const ImageSet& expected, const ImageSet& actual) {
     }
 }
 
+// `image` has a layer `name` that is not all zero (so its lights reached the workers).
+void expectLayer(const ImageSet& image, std::string_view name) {
+    const auto found = std::find_if(image.layers.begin(), image.layers.end(),
+                                    [&](const auto& entry) { return entry.first == name; });
+    ASSERT_NE(found, image.layers.end()) << "no layer " << name;
+    const auto& pixels = found->second.pixels();
+    EXPECT_TRUE(std::any_of(pixels.begin(), pixels.end(), [](const Rgb& p) { return p != Rgb(0.0f); }))
+        << "layer " << name << " is all zero";
+}
+
 // A coordinator on 127.0.0.1:<free port> with a temporary state directory.
 class Cluster {
 public:
@@ -173,7 +183,9 @@ TEST(Service, LightcutsImageAndLayersAreBitIdenticalToTheEmbeddedRender) {
     cluster.startWorker("c");
     const v1::JobSpec spec = makeSpec("vrl-lightcuts", 1, 3, 32, 24, 8);
     const std::string id = cluster.submit(spec);
-    expectBitIdentical(embeddedRender(spec), cluster.waitForImage(id));
+    const ImageSet image = cluster.waitForImage(id);
+    expectBitIdentical(embeddedRender(spec), image);
+    expectLayer(image, kSurfaceVplLayerName);  // part (b)'s surface VPLs and their tree, shipped with the VRLs
     // Every preparation phase is listed once over, in order, however short it was: a client
     // whose polls fell between them still shows each (client/remote_render.cpp).
     const v1::JobProgress progress = cluster.coordinator().jobProgress(id);
@@ -187,7 +199,26 @@ TEST(Service, PlainVrlImageIsBitIdenticalToTheEmbeddedRender) {
     cluster.startWorker("a");
     v1::JobSpec spec = makeSpec("vrl", 1, 5, 16, 12, 8);
     spec.mutable_parameters()->set_vrl_count(500);
-    expectBitIdentical(embeddedRender(spec), cluster.waitForImage(cluster.submit(spec)));
+    const ImageSet image = cluster.waitForImage(cluster.submit(spec));
+    expectBitIdentical(embeddedRender(spec), image);
+    expectLayer(image, kSurfaceVplLayerName);  // part (b)'s surface VPLs, shipped with the VRLs
+}
+
+// Part (b) alone keeps no VRLs, only surface VPLs: they are shipped all the same
+// (a "VRLLIGHT" blob with no VRL part), for the plain and the cut shading.
+TEST(Service, SurfaceVplsAloneAreShippedAndShadeBitIdentically) {
+    Cluster cluster;
+    cluster.startWorker("a");
+    cluster.startWorker("b");
+    for (const char* method : {"vrl", "vrl-lightcuts"}) {
+        SCOPED_TRACE(method);
+        v1::JobSpec spec = makeSpec(method, 1, 9, 16, 12, 8);
+        spec.mutable_parameters()->set_transport("single");
+        spec.mutable_parameters()->set_vrl_count(800);
+        const ImageSet image = cluster.waitForImage(cluster.submit(spec));
+        expectBitIdentical(embeddedRender(spec), image);
+        expectLayer(image, kSurfaceVplLayerName);
+    }
 }
 
 // A time-limited job leases (tile, pass): with --spp 6 as its cap it runs 3

@@ -372,5 +372,276 @@ TEST(LightTreesIo, RejectsEveryFlippedBit) {
         }
 }
 
+// ---- part (b)'s surface VPLs, and the job's lights blob that ships them with the VRLs
+
+constexpr size_t kSurfaceHeaderBytes = 16, kSurfaceVplBytes = 84;
+
+SurfaceVpl randomSurfaceVpl(Rng& rng) {
+    SurfaceVpl v;
+    v.position = {rng.next() * 4 - 2, rng.next() * 4 - 2, rng.next() * 4 - 2};
+    v.geometricNormal = Vec3(rng.next() - 0.5f, rng.next() - 0.5f, rng.next() - 0.5f).normalized();
+    v.shadingNormal = Vec3(rng.next() - 0.5f, rng.next() - 0.5f, rng.next() - 0.5f).normalized();
+    v.uv = {rng.next(), rng.next()};
+    v.shape = rng.nextUint() % 7;
+    v.triangle = rng.nextUint();
+    v.scale = 0.5f + rng.next();
+    v.direction = Vec3(rng.next() - 0.5f, rng.next() - 0.5f, rng.next() - 0.5f).normalized();
+    v.flux = {rng.next(), rng.next(), rng.next()};
+    v.medium = int32_t(rng.nextUint() % 3) - 1;
+    return v;
+}
+
+// Three VPLs with the odd bit patterns a copy through floats would lose, and, with
+// `withTree`, a tree over one proxy per VPL (as prepareSurfaceVpls builds it).
+SurfaceVplLights surfaceVpls(bool withTree) {
+    Rng rng(31, 5);  // seed, stream
+    SurfaceVplLights lights;
+    for (int k = 0; k < 3; ++k) lights.vpls.push_back(randomSurfaceVpl(rng));
+    lights.vpls[0].position.x = -0.0f;
+    lights.vpls[1].flux.y = std::bit_cast<float>(0x7fc12345u);  // a NaN payload
+    lights.vpls[2].uv.y = std::bit_cast<float>(0x00000001u);     // a denormal
+    lights.vpls[2].triangle = 0xffffffffu;
+    if (withTree) {
+        std::vector<Vrl> proxies;  // a point light per VPL, its "flux" an intensity bound
+        for (const SurfaceVpl& vpl : lights.vpls) {
+            Vrl proxy;
+            proxy.origin = vpl.position;
+            proxy.direction = vpl.shadingNormal;
+            proxy.length = 0.0f;
+            proxy.flux = {0.5f + rng.next(), 0.5f + rng.next(), 0.5f + rng.next()};
+            proxy.medium = vpl.medium;
+            proxies.push_back(proxy);
+        }
+        lights.tree = LightTree::build(std::move(proxies), LightTreeSettings{2048, 17, true});
+    }
+    return lights;
+}
+
+void expectSameSurfaceVpls(const SurfaceVplLights& a, const SurfaceVplLights& b) {
+    ASSERT_EQ(a.vpls.size(), b.vpls.size());
+    for (size_t i = 0; i < a.vpls.size(); ++i) {
+        const SurfaceVpl &x = a.vpls[i], &y = b.vpls[i];
+        const std::string at = "vpl " + std::to_string(i) + " ";
+        expectSameBits(x.position, y.position, at + "position");
+        expectSameBits(x.geometricNormal, y.geometricNormal, at + "geometricNormal");
+        expectSameBits(x.shadingNormal, y.shadingNormal, at + "shadingNormal");
+        EXPECT_EQ(bits(x.uv.x), bits(y.uv.x)) << at;
+        EXPECT_EQ(bits(x.uv.y), bits(y.uv.y)) << at;
+        EXPECT_EQ(x.shape, y.shape) << at;
+        EXPECT_EQ(x.triangle, y.triangle) << at;
+        EXPECT_EQ(bits(x.scale), bits(y.scale)) << at;
+        expectSameBits(x.direction, y.direction, at + "direction");
+        expectSameBits(x.flux, y.flux, at + "flux");
+        EXPECT_EQ(x.medium, y.medium) << at;
+    }
+    expectSameTree(a.tree, b.tree);
+}
+
+void expectSurfaceRejected(const std::vector<uint8_t>& blob, const std::vector<std::string>& parts,
+                           const std::string& context = "") {
+    try {
+        deserializeSurfaceVpls(blob.data(), blob.size());
+        ADD_FAILURE() << "accepted a bad blob " << context;
+    } catch (const std::runtime_error& e) {
+        for (const std::string& part : parts)
+            EXPECT_NE(std::string(e.what()).find(part), std::string::npos)
+                << "message \"" << e.what() << "\" lacks \"" << part << "\" " << context;
+    }
+}
+
+TEST(SurfaceVplIo, VplsWithoutATreeRoundTripBitExactly) {
+    const SurfaceVplLights lights = surfaceVpls(false);
+    const std::vector<uint8_t> blob = serializeSurfaceVpls(lights);
+    EXPECT_EQ(blob.size(), kSurfaceHeaderBytes + 3 * kSurfaceVplBytes + 4 + 4);  // + tree flag, crc
+    EXPECT_EQ(std::string(blob.begin(), blob.begin() + 8), "VRLSVPLS");
+    const SurfaceVplLights back = deserializeSurfaceVpls(blob.data(), blob.size());
+    EXPECT_TRUE(back.tree.empty());
+    expectSameSurfaceVpls(lights, back);
+    EXPECT_EQ(serializeSurfaceVpls(back), blob);
+}
+
+TEST(SurfaceVplIo, VplsWithTheirTreeRoundTripBitExactly) {
+    const SurfaceVplLights lights = surfaceVpls(true);
+    const std::vector<uint8_t> blob = serializeSurfaceVpls(lights);
+    const std::vector<uint8_t> tree = serializeLightTree(lights.tree);
+    EXPECT_EQ(blob.size(), kSurfaceHeaderBytes + 3 * kSurfaceVplBytes + 4 + 8 + tree.size() + 4);
+    // The tree is serializeLightTree's blob, verbatim, after its flag and size.
+    const size_t treeAt = kSurfaceHeaderBytes + 3 * kSurfaceVplBytes + 4 + 8;
+    EXPECT_EQ(std::vector<uint8_t>(blob.begin() + treeAt, blob.begin() + treeAt + tree.size()), tree);
+    const SurfaceVplLights back = deserializeSurfaceVpls(blob.data(), blob.size());
+    EXPECT_FALSE(back.tree.empty());
+    expectSameSurfaceVpls(lights, back);
+    EXPECT_EQ(serializeSurfaceVpls(back), blob);
+}
+
+TEST(SurfaceVplIo, NoVplsRoundTrip) {
+    const std::vector<uint8_t> blob = serializeSurfaceVpls(SurfaceVplLights());
+    const SurfaceVplLights back = deserializeSurfaceVpls(blob.data(), blob.size());
+    EXPECT_TRUE(back.vpls.empty());
+    EXPECT_TRUE(back.tree.empty());
+}
+
+TEST(SurfaceVplIo, RefusesToWriteATreeOfAnotherSize) {
+    SurfaceVplLights lights = surfaceVpls(true);
+    lights.vpls.pop_back();
+    EXPECT_THROW(serializeSurfaceVpls(lights), std::invalid_argument);
+}
+
+TEST(SurfaceVplIo, RejectsWrongMagicAndVersion) {
+    std::vector<uint8_t> blob = serializeSurfaceVpls(surfaceVpls(true));
+    expectSurfaceRejected(serializeLightTree(smallTree()), {"not a surface VPL blob", "VRLSVPLS"});
+    std::vector<uint8_t> bad = blob;
+    bad[4] = 'X';
+    expectSurfaceRejected(bad, {"not a surface VPL blob"});
+    putU32(blob, 8, kLightTreeFormatVersion + 1);
+    resealCrc(blob);
+    expectSurfaceRejected(blob, {"version " + std::to_string(kLightTreeFormatVersion + 1),
+                                 "version " + std::to_string(kLightTreeFormatVersion)});
+}
+
+TEST(SurfaceVplIo, RejectsEveryTruncationAndTrailingBytes) {
+    for (const bool withTree : {false, true}) {
+        const std::vector<uint8_t> blob = serializeSurfaceVpls(surfaceVpls(withTree));
+        for (size_t n = 0; n < blob.size(); ++n) {
+            const std::vector<uint8_t> cut(blob.begin(), blob.begin() + n);  // exactly n bytes, for sanitizers
+            expectSurfaceRejected(cut, {}, "at " + std::to_string(n));
+        }
+        std::vector<uint8_t> longer = blob;
+        longer.push_back(0);
+        expectSurfaceRejected(longer, {"wrong size", "found " + std::to_string(longer.size())});
+    }
+}
+
+TEST(SurfaceVplIo, RejectsEveryFlippedBit) {
+    const std::vector<uint8_t> blob = serializeSurfaceVpls(surfaceVpls(true));
+    for (size_t byte = 0; byte < blob.size(); ++byte)
+        for (int bit = 0; bit < 8; ++bit) {
+            std::vector<uint8_t> bad = blob;
+            bad[byte] ^= uint8_t(1u << bit);
+            // Past the header, the VPLs' bytes are guarded by the checksum alone.
+            const bool inVpls = byte >= kSurfaceHeaderBytes && byte < kSurfaceHeaderBytes + 3 * kSurfaceVplBytes;
+            expectSurfaceRejected(bad, inVpls ? std::vector<std::string>{"checksum"} : std::vector<std::string>{},
+                                  "flipping byte " + std::to_string(byte) + " bit " + std::to_string(bit));
+        }
+}
+
+TEST(SurfaceVplIo, RejectsHugeCountsWithoutAllocating) {
+    std::vector<uint8_t> blob = serializeSurfaceVpls(surfaceVpls(false));
+    putU32(blob, 12, 0xffffffffu);
+    resealCrc(blob);
+    // Allocating 2^32 VPLs (360 GB) first would throw std::bad_alloc or die, not this.
+    expectSurfaceRejected(blob, {"truncated", "4294967295 VPLs"});
+}
+
+TEST(SurfaceVplIo, RejectsABadTreeFlagOrTreeSize) {
+    const size_t flagAt = kSurfaceHeaderBytes + 3 * kSurfaceVplBytes;
+    std::vector<uint8_t> blob = serializeSurfaceVpls(surfaceVpls(true));
+    putU32(blob, flagAt, 2);
+    resealCrc(blob);
+    expectSurfaceRejected(blob, {"tree flag is 2"});
+    blob = serializeSurfaceVpls(surfaceVpls(true));
+    putU32(blob, flagAt + 8, 1);  // the size's high word: past the blob
+    resealCrc(blob);
+    expectSurfaceRejected(blob, {"exceeds the blob"});
+}
+
+// A valid tree (its own checksum right) over another number of lights than there are VPLs.
+TEST(SurfaceVplIo, RejectsATreeWhoseSizeDiffersFromTheVpls) {
+    SurfaceVplLights lights = surfaceVpls(true);
+    Rng rng(5, 5);
+    lights.vpls.push_back(randomSurfaceVpl(rng));  // 4 VPLs, the tree's 3 proxies
+    std::vector<uint8_t> blob;
+    {
+        // serializeSurfaceVpls refuses this, so write the 4 VPLs, then splice in the 3-light tree.
+        SurfaceVplLights four;
+        four.vpls = lights.vpls;
+        blob = serializeSurfaceVpls(four);
+        blob.resize(blob.size() - 8);  // drop the flag (0) and crc
+        const std::vector<uint8_t> tree = serializeLightTree(lights.tree);
+        const auto put = [&](uint32_t v) {
+            for (int i = 0; i < 4; ++i) blob.push_back(uint8_t(v >> (8 * i)));
+        };
+        put(1);
+        put(uint32_t(tree.size()));
+        put(0);
+        blob.insert(blob.end(), tree.begin(), tree.end());
+        put(0);
+        resealCrc(blob);
+    }
+    expectSurfaceRejected(blob, {"inconsistent", "tree holds 3 lights", "one per VPL (4)"});
+    // And a tree that deserializeLightTree refuses is named as the surface VPLs' tree.
+    std::vector<uint8_t> bad = serializeSurfaceVpls(surfaceVpls(true));
+    const size_t treeAt = kSurfaceHeaderBytes + 3 * kSurfaceVplBytes + 4 + 8;
+    bad[treeAt + 30] ^= 1;  // inside the tree: its own checksum fails
+    resealCrc(bad);
+    expectSurfaceRejected(bad, {"its tree", "checksum"});
+}
+
+// ---- the job's lights blob
+
+void expectJobLightsRejected(const std::vector<uint8_t>& blob, const std::vector<std::string>& parts,
+                             const std::string& context = "") {
+    try {
+        parseJobLights(blob.data(), blob.size());
+        ADD_FAILURE() << "accepted a bad blob " << context;
+    } catch (const std::runtime_error& e) {
+        for (const std::string& part : parts)
+            EXPECT_NE(std::string(e.what()).find(part), std::string::npos)
+                << "message \"" << e.what() << "\" lacks \"" << part << "\" " << context;
+    }
+}
+
+TEST(JobLightsIo, HoldsBothBlobsVerbatim) {
+    const std::vector<uint8_t> primary = serializeLightTree(smallTree());
+    const SurfaceVplLights lights = surfaceVpls(true);
+    const std::vector<uint8_t> surface = serializeSurfaceVpls(lights);
+    const std::vector<uint8_t> blob = serializeJobLights(primary, surface);
+    EXPECT_EQ(blob.size(), 8 + 4 + 8 + 8 + primary.size() + surface.size() + 4);
+    EXPECT_EQ(std::string(blob.begin(), blob.begin() + 8), "VRLLIGHT");
+    const JobLightsParts parts = parseJobLights(blob.data(), blob.size());
+    EXPECT_EQ(std::vector<uint8_t>(parts.primary.begin(), parts.primary.end()), primary);
+    EXPECT_EQ(std::vector<uint8_t>(parts.surfaceVpls.begin(), parts.surfaceVpls.end()), surface);
+    expectSameTree(smallTree(), deserializeLightTree(parts.primary.data(), parts.primary.size()));
+    expectSameSurfaceVpls(lights, deserializeSurfaceVpls(parts.surfaceVpls.data(), parts.surfaceVpls.size()));
+    EXPECT_EQ(serializeJobLights(parts.primary, parts.surfaceVpls), blob);
+}
+
+// Part (b) alone (--transport single): no VRLs are kept, the surface VPLs still ship.
+TEST(JobLightsIo, AnEmptyPrimaryBlobIsNone) {
+    const std::vector<uint8_t> surface = serializeSurfaceVpls(surfaceVpls(false));
+    const std::vector<uint8_t> blob = serializeJobLights({}, surface);
+    const JobLightsParts parts = parseJobLights(blob.data(), blob.size());
+    EXPECT_TRUE(parts.primary.empty());
+    EXPECT_EQ(std::vector<uint8_t>(parts.surfaceVpls.begin(), parts.surfaceVpls.end()), surface);
+}
+
+TEST(JobLightsIo, RejectsOtherBlobsTruncationSizesAndFlippedBits) {
+    const std::vector<uint8_t> blob =
+        serializeJobLights(serializeVrlSet(VrlSet{}), serializeSurfaceVpls(surfaceVpls(true)));
+    expectJobLightsRejected(serializeLightTree(smallTree()), {"not a job lights blob", "VRLLIGHT"});
+    std::vector<uint8_t> other = blob;
+    putU32(other, 8, kLightTreeFormatVersion + 1);
+    resealCrc(other);
+    expectJobLightsRejected(other, {"format version " + std::to_string(kLightTreeFormatVersion + 1)});
+    for (size_t n = 0; n < blob.size(); ++n)
+        expectJobLightsRejected(std::vector<uint8_t>(blob.begin(), blob.begin() + n), {}, "at " + std::to_string(n));
+    std::vector<uint8_t> longer = blob;
+    longer.push_back(0);
+    expectJobLightsRejected(longer, {"wrong size"});
+    for (const uint32_t huge : {0xffffffffu, 1u}) {  // high words: sizes past the blob
+        std::vector<uint8_t> bad = blob;
+        putU32(bad, 16, huge);
+        putU32(bad, 24, huge == 1u ? 0u : 0xffffffffu);
+        resealCrc(bad);
+        expectJobLightsRejected(bad, {"wrong size"});
+    }
+    for (size_t byte = 0; byte < blob.size(); ++byte)
+        for (int bit = 0; bit < 8; ++bit) {
+            std::vector<uint8_t> bad = blob;
+            bad[byte] ^= uint8_t(1u << bit);
+            expectJobLightsRejected(bad, {}, "flipping byte " + std::to_string(byte) + " bit " + std::to_string(bit));
+        }
+}
+
 }  // namespace
 }  // namespace vrl
