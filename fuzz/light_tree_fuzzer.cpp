@@ -1,8 +1,8 @@
-// libFuzzer target: the light-tree and VRL-set deserialisers
-// (render/light_tree_io.h).
+// libFuzzer target: the light-tree, VRL-set, surface-VPL and job-lights
+// deserialisers (render/lightcuts/light_tree_io.h).
 //
-// Every input is given to both vrl::deserializeLightTree and
-// vrl::deserializeVrlSet twice: as it is, and with its last four bytes replaced
+// Every input is given to vrl::deserializeLightTree, vrl::deserializeVrlSet,
+// vrl::deserializeSurfaceVpls and vrl::parseJobLights twice: as it is, and with its last four bytes replaced
 // by the CRC-32 of the rest, so that mutations get past the checksum and reach
 // the size checks and LightTree::fromParts. What deserialises must serialise
 // back to the very same bytes (the documented bit-exact inverse); a difference
@@ -44,6 +44,26 @@ void check(const uint8_t* data, size_t size) {
     } catch (const std::exception& e) {
         if (vrl_fuzz::strictExceptions()) vrl_fuzz::undocumented("deserializeLightTree", e);
         vrl_fuzz::refused("deserializeLightTree", e);
+    }
+    try {
+        const vrl::SurfaceVplLights lights = vrl::deserializeSurfaceVpls(data, size);
+        mustEqual(vrl::serializeSurfaceVpls(lights), data, size, "surface VPLs");
+        vrl_fuzz::accepted("surface VPLs");
+    } catch (const std::runtime_error& e) {
+        vrl_fuzz::refused("deserializeSurfaceVpls", e);
+    } catch (const std::exception& e) {
+        if (vrl_fuzz::strictExceptions()) vrl_fuzz::undocumented("deserializeSurfaceVpls", e);
+        vrl_fuzz::refused("deserializeSurfaceVpls", e);
+    }
+    try {
+        const vrl::JobLightsParts parts = vrl::parseJobLights(data, size);
+        mustEqual(vrl::serializeJobLights(parts.primary, parts.surfaceVpls), data, size, "job lights");
+        vrl_fuzz::accepted("job lights");
+    } catch (const std::runtime_error& e) {
+        vrl_fuzz::refused("parseJobLights", e);
+    } catch (const std::exception& e) {
+        if (vrl_fuzz::strictExceptions()) vrl_fuzz::undocumented("parseJobLights", e);
+        vrl_fuzz::refused("parseJobLights", e);
     }
     try {
         const vrl::VrlSet set = vrl::deserializeVrlSet(data, size);
