@@ -122,7 +122,7 @@ TEST(ProgressiveRender, SamplesAndPerPixelPartsIgnoreTheSampleCount) {
             EXPECT_TRUE(bitIdentical(one.layers[l], nine.layers[l])) << nineShader.layerNames()[l - 1];
         }
         if (method == RenderMethod::VrlLightcuts) {
-            EXPECT_EQ(perPixelLayers, 8u) << "(c), (d) and six cut counters";
+            EXPECT_EQ(perPixelLayers, 12u) << "(c), (d), (b)'s surface VPLs and nine cut counters";
             EXPECT_EQ(one.boundedEstimates, nine.boundedEstimates);
         }
         if (method == RenderMethod::VrlStochastic) {
