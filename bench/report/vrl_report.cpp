@@ -876,7 +876,8 @@ std::string verdict(const std::vector<RunResult>& results, const std::string& na
         v << "VRL Lightcuts does **not** reach 10× less time than plain VRLs at equal error: at most "
           << fmt(*bestSpeedup) << "×. Per pixel it evaluates #Eval = " << cost
           << " VRLs over its camera segments (plain VRLs evaluate all N on each)"
-          << (multipleOnly ? "" : "; parts (a) and (b) are path-sampled alike in both and cost both the same time")
+          << (multipleOnly ? "" : "; part (a) is path-sampled alike in both and costs both the same time, and both take part (b)'s "
+                                 "surface light from surface VPLs (plain VRLs from every VPL, VRL Lightcuts by a cut)")
           << ". ";
     }
     const bool vplRun = std::any_of(results.begin(), results.end(), [&](const RunResult& r) {
@@ -1102,7 +1103,9 @@ void writeSummary(const fs::path& path, const Options& o, const std::vector<Scen
           "methods and left out. The VRL methods render parts (a) and (b) by path sampling at the stated spp (their "
           "noise is part of the whole image's error, and the spp grow with N along each curve) and parts (c) and (d) "
           "with their VRLs: plain VRLs and VRL Lightcuts (relative error threshold e, 0.02 unless stated) once per "
-          "pixel, stochastic VRL Lightcuts at every sample (K VRLs per camera segment and surface point). VPL "
+          "pixel, with part (b)'s non-Dirac surface light from surface VPLs of the same light paths (every VPL or a "
+          "cut, once per pixel), stochastic VRL Lightcuts at every sample (K VRLs per camera segment and surface "
+          "point). VPL "
           "Lightcuts path-samples part (c) too and gathers (d) without clamping, as in the paper, at "
        << kDefaultVplDistanceSamples
        << " stratified distance samples per camera segment, or D where a label says D=... (fewer: cheaper and noisier; "
