@@ -277,7 +277,8 @@ void checkLightsMatchScene(const Scene& scene, const RenderLights& lights) {
     }
     if (!surface.tree.empty() && surface.tree.vrls().size() != surface.vpls.size())
         throw std::invalid_argument("the surface VPL tree holds " + std::to_string(surface.tree.vrls().size()) +
-                                    " lights but the list " + std::to_string(surface.vpls.size()));
+                                    " lights but the list beside it " + std::to_string(surface.vpls.size()) +
+                                    ": the lights are corrupt");
 }
 
 }  // namespace
