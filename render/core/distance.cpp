@@ -104,7 +104,8 @@ SegmentBoxDistances distancesSegmentBox(const Vec3& origin, const Vec3& directio
         breaks[count++] = (double(box.min[axis]) - double(origin[axis])) / d;
         breaks[count++] = (double(box.max[axis]) - double(origin[axis])) / d;
     }
-    std::sort(breaks, breaks + count);
+    for (int i = 1; i < count; ++i)  // insertion sort of at most 6 (std::sort trips GCC 12's -Warray-bounds here)
+        for (int j = i; j > 0 && breaks[j] < breaks[j - 1]; --j) std::swap(breaks[j], breaks[j - 1]);
     // The squared distance on the piece containing t: sum over axes of (outside gap)^2,
     // each gap linear in t on the piece: A t^2 + B t + C.
     const auto pieceMinimum = [&](double a, double b) {  // min over [a, b] of the piece around (a + b) / 2
