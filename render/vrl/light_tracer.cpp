@@ -2,6 +2,7 @@
 
 #include "render/core/rng.h"
 #include "render/core/sampling.h"
+#include "render/vrl/surface_vpl_estimator.h"
 
 #include <spdlog/spdlog.h>
 #include <tbb/parallel_for.h>
@@ -147,8 +148,7 @@ void LightPathWalker::trace(uint64_t index, std::vector<Vrl>* out,
         if (visit && !shape.bsdf.isPurelySpecular())
             (*visit)(LightPathVertex{hit->position, ray.direction, throughput, medium, &*hit, vertices});
         if (surfaceOut && !shape.bsdf.isPurelySpecular())
-            surfaceOut->push_back({hit->position, hit->geometricNormal, hit->shadingNormal, hit->uv, hit->shape,
-                                   hit->triangle, hit->scale, ray.direction, throughput, medium});
+            surfaceOut->push_back(surfaceVplAt(*hit, ray.direction, throughput, medium));
         const auto sampled = shape.bsdf.sample(hit->shadingPoint(), -ray.direction, Vec2(rng.next(), rng.next()),
                                                rng.next(), TransportMode::Importance);
         if (!sampled || isBlack(sampled->weight)) return;  // Bsdf::sample returns finite weights

@@ -60,6 +60,13 @@ inline SurfaceHit surfaceHitOf(const SurfaceVpl& vpl) {
     return hit;
 }
 
+// A VPL at a surface hit: the light arriving along `direction` (unit, the way it
+// travels) with `flux`, through `medium`. The inverse of surfaceHitOf.
+inline SurfaceVpl surfaceVplAt(const SurfaceHit& hit, const Vec3& direction, const Rgb& flux, int32_t medium) {
+    return {hit.position, hit.geometricNormal, hit.shadingNormal, hit.uv, hit.shape, hit.triangle, hit.scale,
+            direction, flux, medium};
+}
+
 class SurfaceVplEstimator {
 public:
     explicit SurfaceVplEstimator(const Scene& scene) : scene_(scene) {}

@@ -117,18 +117,7 @@ std::vector<SurfaceVpl> randomVpls(const Scene& scene, Rng& rng, int count) {
         const Vec3 d = (target - from).normalized();
         const auto hit = scene.intersect(Ray{from, d});
         if (!hit) continue;
-        SurfaceVpl v;
-        v.position = hit->position;
-        v.geometricNormal = hit->geometricNormal;
-        v.shadingNormal = hit->shadingNormal;
-        v.uv = hit->uv;
-        v.shape = hit->shape;
-        v.triangle = hit->triangle;
-        v.scale = hit->scale;
-        v.direction = d;
-        v.flux = Rgb(0.2f + rng.next(), 0.2f + rng.next(), 0.2f + rng.next()) * 1e-3f;
-        v.medium = 0;
-        vpls.push_back(v);
+        vpls.push_back(surfaceVplAt(*hit, d, Rgb(0.2f + rng.next(), 0.2f + rng.next(), 0.2f + rng.next()) * 1e-3f, 0));
     }
     return vpls;
 }
@@ -449,18 +438,8 @@ TEST(SurfaceVplCut, RepresentativeWithAZeroChannelKeepsTheClustersLight) {
         const Vec3 from = target + Vec3(0.2f, 0.1f, 1.0f);
         const auto hit = scene->intersect(Ray{from, (target - from).normalized()});
         ASSERT_TRUE(hit.has_value());
-        SurfaceVpl v;
-        v.position = hit->position;
-        v.geometricNormal = hit->geometricNormal;
-        v.shadingNormal = hit->shadingNormal;
-        v.uv = hit->uv;
-        v.shape = hit->shape;
-        v.triangle = hit->triangle;
-        v.scale = hit->scale;
-        v.direction = (target - from).normalized();
-        v.flux = vpls.empty() ? Rgb(1e-3f, 1e-3f, 0.0f) : Rgb(1e-3f);  // the first has no blue
-        v.medium = 0;
-        vpls.push_back(v);
+        const Rgb flux = vpls.empty() ? Rgb(1e-3f, 1e-3f, 0.0f) : Rgb(1e-3f);  // the first has no blue
+        vpls.push_back(surfaceVplAt(*hit, (target - from).normalized(), flux, 0));
     }
     // A tree whose root represents the blue-less VPL.
     SurfaceVplLights lights;

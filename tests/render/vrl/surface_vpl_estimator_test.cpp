@@ -66,18 +66,7 @@ SurfaceVpl vplFrom(const Scene& scene, const Vec3& from, const Vec3& target, con
     const Vec3 direction = (target - from).normalized();
     const auto hit = scene.intersect(Ray{from, direction});
     EXPECT_TRUE(hit.has_value());
-    SurfaceVpl v;
-    v.position = hit->position;
-    v.geometricNormal = hit->geometricNormal;
-    v.shadingNormal = hit->shadingNormal;
-    v.uv = hit->uv;
-    v.shape = hit->shape;
-    v.triangle = hit->triangle;
-    v.scale = hit->scale;
-    v.direction = direction;
-    v.flux = flux;
-    v.medium = 0;
-    return v;
+    return surfaceVplAt(*hit, direction, flux, 0);
 }
 
 CameraSegment makeSegment(const Vec3& origin, const Vec3& direction, float length, const Rgb& beta = Rgb(1.0f)) {
