@@ -174,9 +174,12 @@ Rgb ClusterBound::bound(int32_t index, const CameraSegment& segment, bool* lineC
     const double span = maxSubtendedAngle(segment.length, h);
     const double phase = phaseFactor(index, segment, h, slack, span);
     if (!std::isfinite(phase)) return Rgb(std::numeric_limits<float>::infinity());
-    // T_r(w) <= T_r(h_min) only if the segment between u and v stays in this one convex medium.
+    // T(u) T_r(w) = exp(-sigma_t (u + w)) <= exp(-sigma_t d_o), d_o the distance from the
+    // segment's origin to the box (>= h_min; triangle inequality), only if the segment
+    // between u and v stays in this one convex medium.
     Rgb between(1.0f);
-    if (node.medium == segment.medium && cameraMedium.boundaryConvex()) between = cameraMedium.transmittance(float(h));
+    if (node.medium == segment.medium && cameraMedium.boundaryConvex())
+        between = cameraMedium.transmittanceBound(std::max(h, distancePointBox(segment.origin, node.box) - slack));
     // The node is estimated by its representative with flux Phi_C: the bound's
     // Phi L factor is Phi_C L_rep = the node's flux x length (<= Phi_C L_max, Eq. 11's).
     const double scale = kRoundingMargin * phase * span / h;

@@ -43,7 +43,10 @@ SurfaceVplLights prepareSurfaceVpls(const Scene& scene, std::vector<SurfaceVpl> 
         const Rgb intensity = vpls[k].flux * surfaceVplReflectionBound(scene, vpls[k]);
         if (!(maxComponent(intensity) > 0.0f) || !isFinite(intensity)) continue;
         vpls[kept++] = vpls[k];
-        if (buildTree) proxies.push_back(Vrl{vpls[k].position, vpls[k].direction, 0.0f, intensity, -1});
+        // The proxy's medium: the VPL's, where its shape bounds no medium (light leaves it
+        // into that medium whichever side it reflects to), else -1 (no transmittance bound).
+        const int medium = scene.shapes()[vpls[k].shape].changesMedium ? -1 : vpls[k].medium;
+        if (buildTree) proxies.push_back(Vrl{vpls[k].position, vpls[k].direction, 0.0f, intensity, medium});
     }
     vpls.resize(kept);
     vpls.shrink_to_fit();
@@ -103,7 +106,8 @@ Rgb SurfaceVplLightcutsEstimator::bound(int32_t index, const CameraSegment& segm
         distancesSegmentBox(segment.origin, segment.direction, double(segment.length), node.box);
     const double dLine = distances.line - slack, dSegment = distances.segment - slack;
     double geometry = std::numeric_limits<double>::infinity();
-    if (dLine > 0.0) geometry = std::acos(-1.0) / dLine;
+    // The angle a segment of length S subtends from distance h is at most 2 atan(S / 2h) (<= pi).
+    if (dLine > 0.0) geometry = 2.0 * std::atan(double(segment.length) / (2.0 * dLine)) / dLine;
     if (dSegment > 0.0) geometry = std::min(geometry, double(segment.length) / (dSegment * dSegment));
     if (!std::isfinite(geometry)) return Rgb(std::numeric_limits<float>::infinity());
     // The cosine at y (surface_vpl_cut.h), for nodes of Lambertian VPLs with nearly one normal.
@@ -114,9 +118,16 @@ Rgb SurfaceVplLightcutsEstimator::bound(int32_t index, const CameraSegment& segm
         const double h = std::max({0.0, std::max(0.0, along) - boxLow, boxHigh - std::min(0.0, along)}) + slack;
         if (dSegment > 0.0) geometry *= std::min(1.0, h / dSegment + double(n.spread));
     }
+    // Transmittance (surface_vpl_cut.h): T_m(t) T_r = exp(-sigma_t (t + r)) <= exp(-sigma_t d_o).
+    Rgb transmittance(1.0f);
+    if (node.medium == segment.medium && medium.boundaryConvex()) {
+        const double dOrigin = distancePointBox(segment.origin, node.box) - slack;
+        if (dOrigin > 0.0) transmittance = medium.transmittanceBound(dOrigin);
+    }
     const double g = std::abs(double(medium.phase().g()));
     const double phaseMax = medium.phase().isIsotropic() ? double(kInv4Pi) : double(kInv4Pi) * (1.0 + g) / ((1.0 - g) * (1.0 - g));
-    return node.clusterFlux * medium.sigmaS() * segment.throughputBefore * float(kRoundingMargin * phaseMax * geometry);
+    return node.clusterFlux * medium.sigmaS() * segment.throughputBefore * transmittance *
+           float(kRoundingMargin * phaseMax * geometry);
 }
 
 Rgb SurfaceVplLightcutsEstimator::estimate(const CameraSegment& segment, uint64_t streamKey, CutStatistics& statistics,

@@ -18,14 +18,20 @@
 // Bound (proof). For every VPL k of node C (box B) and any sample t of a
 // segment (o, d, S, medium m, throughput beta), the estimate is
 //   beta T_m(t) sigma_s f_p T_r V Phi_k f_s,k (theta_B - theta_A) / h
-//     <= beta sigma_s f_p,max I_k G,   G = min(S / d_s^2, pi / d_l),
+//     <= beta sigma_s f_p,max I_k G,   G = min(S / d_s^2, 2 atan(S / 2 d_l) / d_l),
 // because T_m, T_r, V <= 1; f_s,k <= F_k; f_p <= f_p,max (1/4pi isotropic,
 // (1 + |g|) / (4 pi (1 - |g|)^2) for Henyey-Greenstein, its value at cos = +-1);
 // and (theta_B - theta_A)/h = integral_0^S dt / |u(t) - y|^2 is at most S / d_s^2
 // (d_s: distance from y to the segment, bounded below by the distance between B
-// and the segment's bounding box) and at most the whole line's integral pi / h
-// (h >= d_l, the distance from the line to B). A node's estimate is
+// and the segment) and at most 2 atan(S / 2h) / h <= pi / h (h >= d_l, the distance
+// from the line to B; decreasing in h). A node's estimate is
 // sum-weighted by I_C / I_r, so it is at most beta sigma_s f_p,max I_C G.
+// Transmittance: where every VPL of the node lies in the segment's medium on a
+// shape that bounds no medium (the proxy's medium, else -1) and that medium's
+// boundary is convex, u -> y stays in it, so T_m(t) T_r = exp(-sigma_t (t + r))
+// with t + r >= |o - y| >= d_o, the distance from the segment's origin o to B:
+// the bound takes the factor T(d_o). G uses 2 atan(S / 2 d_l) / d_l, the
+// largest angle the segment subtends from distance d_l, not pi / d_l.
 // The cosine at y, where every VPL of the node has a Lambertian bound and their
 // geometric normals n_k lie within eps of one axis a (|n_k - a| <= eps: a floor, a
 // wall): for Lambertian-bounded models f_s = F_k |w.n_g| at most (the importance-mode

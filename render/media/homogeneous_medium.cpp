@@ -1,5 +1,6 @@
 #include "render/media/homogeneous_medium.h"
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 
@@ -29,6 +30,13 @@ Rgb HomogeneousMedium::transmittance(float distance) const {
 
 float HomogeneousMedium::freeFlightPdf(float t) const {
     return average(sigmaT_ * transmittance(t));
+}
+
+Rgb HomogeneousMedium::transmittanceBound(double distance) const {
+    const auto channel = [distance](float sigmaT) {
+        return float(std::max(std::exp(-double(sigmaT) * std::max(distance, 0.0)), 1e-30));
+    };
+    return {channel(sigmaT_.x), channel(sigmaT_.y), channel(sigmaT_.z)};
 }
 
 float HomogeneousMedium::passProbability(float tMax) const { return average(transmittance(tMax)); }

@@ -42,6 +42,10 @@ public:
     void setBoundaryConvex(bool convex) { boundaryConvex_ = convex; }
 
     Rgb transmittance(float distance) const;
+    // An upper bound of transmittance over every path of length >= distance, for
+    // cluster bounds: floored at 1e-30 per channel, so that a bound's product of
+    // factors does not underflow to 0 where the estimate it bounds is a denormal.
+    Rgb transmittanceBound(double distance) const;
     // Samples a collision distance along [0, tMax) (tMax may be infinite) from two uniforms.
     FreeFlightSample sampleFreeFlight(float tMax, float uChannel, float uDistance) const;
     // The densities behind sampleFreeFlight: collision at t < tMax, and passing tMax.
