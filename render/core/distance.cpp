@@ -95,55 +95,54 @@ SegmentBoxDistances distancesSegmentBox(const Vec3& origin, const Vec3& directio
                                         const Imath::Box3f& box) {
     constexpr double kInf = std::numeric_limits<double>::infinity();
     if (box.isEmpty()) return {kInf, kInf};
-    // Slab crossings: where a coordinate of the line meets a face plane.
+    const double o[3] = {origin.x, origin.y, origin.z}, d[3] = {direction.x, direction.y, direction.z};
+    const double lo[3] = {box.min.x, box.min.y, box.min.z}, hi[3] = {box.max.x, box.max.y, box.max.z};
+    // f(t) = squared distance from o + t d to the box: convex, quadratic between slab crossings.
+    const auto squared = [&](double t) {
+        double sum = 0.0;
+        for (int a = 0; a < 3; ++a) {
+            const double x = o[a] + t * d[a];
+            const double gap = x < lo[a] ? lo[a] - x : x > hi[a] ? x - hi[a] : 0.0;
+            sum += gap * gap;
+        }
+        return sum;
+    };
+    const auto slope = [&](double t) {  // f'(t) / 2, non-decreasing
+        double sum = 0.0;
+        for (int a = 0; a < 3; ++a) {
+            const double x = o[a] + t * d[a];
+            if (x < lo[a]) sum += (x - lo[a]) * d[a];
+            else if (x > hi[a]) sum += (x - hi[a]) * d[a];
+        }
+        return sum;
+    };
     double breaks[6];
     int count = 0;
-    for (int axis = 0; axis < 3; ++axis) {
-        const double d = direction[axis];
-        if (d == 0.0) continue;
-        breaks[count++] = (double(box.min[axis]) - double(origin[axis])) / d;
-        breaks[count++] = (double(box.max[axis]) - double(origin[axis])) / d;
+    for (int a = 0; a < 3; ++a) {
+        if (d[a] == 0.0) continue;
+        breaks[count++] = (lo[a] - o[a]) / d[a];
+        breaks[count++] = (hi[a] - o[a]) / d[a];
     }
     for (int i = 1; i < count; ++i)  // insertion sort of at most 6 (std::sort trips GCC 12's -Warray-bounds here)
         for (int j = i; j > 0 && breaks[j] < breaks[j - 1]; --j) std::swap(breaks[j], breaks[j - 1]);
-    // The squared distance on the piece containing t: sum over axes of (outside gap)^2,
-    // each gap linear in t on the piece: A t^2 + B t + C.
-    const auto pieceMinimum = [&](double a, double b) {  // min over [a, b] of the piece around (a + b) / 2
-        const double mid = std::isfinite(a) && std::isfinite(b) ? 0.5 * (a + b) : std::isfinite(a) ? a + 1.0 : b - 1.0;
-        double A = 0.0, B = 0.0, C = 0.0;
-        for (int axis = 0; axis < 3; ++axis) {
-            const double o = origin[axis], d = direction[axis], lo = box.min[axis], hi = box.max[axis];
-            const double x = o + mid * d;
-            double p0, p1;  // gap = p0 + p1 t
-            if (x < lo) p0 = lo - o, p1 = -d;
-            else if (x > hi) p0 = o - hi, p1 = d;
-            else continue;
-            A += p1 * p1, B += 2.0 * p0 * p1, C += p0 * p0;
-        }
-        const auto value = [&](double t) { return std::max(0.0, (A * t + B) * t + C); };
-        double best = kInf;
-        if (std::isfinite(a)) best = std::min(best, value(a));
-        if (std::isfinite(b)) best = std::min(best, value(b));
-        if (A > 0.0) {
-            const double t = -B / (2.0 * A);
-            if (t >= a && t <= b) best = std::min(best, value(t));
-        } else if (!std::isfinite(a) || !std::isfinite(b)) {
-            best = std::min(best, C);  // constant on an unbounded piece (B = 0 when A = 0)
-        }
-        return best;
-    };
-    double line = kInf, segment = kInf;
-    double from = -kInf;
-    for (int k = 0; k <= count; ++k) {
-        const double to = k < count ? breaks[k] : kInf;
-        if (to >= from) {
-            line = std::min(line, pieceMinimum(from, to));
-            const double a = std::max(from, 0.0), b = std::min(to, length);
-            if (a <= b) segment = std::min(segment, pieceMinimum(a, b));
-        }
-        from = to;
+    // The piece [from, to] holding a minimiser: the first crossing where f' >= 0 ends it.
+    int k = 0;
+    while (k < count && slope(breaks[k]) < 0.0) ++k;
+    const double from = k > 0 ? breaks[k - 1] : -kInf, to = k < count ? breaks[k] : kInf;
+    // On it f = A t^2 + B t + C with the axes outside the box at its middle.
+    const double mid = std::isfinite(from) && std::isfinite(to) ? 0.5 * (from + to) : std::isfinite(from) ? from + 1.0
+                                                                                     : std::isfinite(to) ? to - 1.0 : 0.0;
+    double A = 0.0, B = 0.0;
+    for (int a = 0; a < 3; ++a) {
+        const double x = o[a] + mid * d[a];
+        if (x < lo[a]) A += d[a] * d[a], B += 2.0 * (o[a] - lo[a]) * d[a];
+        else if (x > hi[a]) A += d[a] * d[a], B += 2.0 * (o[a] - hi[a]) * d[a];
     }
-    return {std::sqrt(segment), std::sqrt(line)};
+    // A = 0: f is constant (0) on the piece, any point of it minimises.
+    double best = A > 0.0 ? -B / (2.0 * A) : mid;
+    best = std::clamp(best, from, to);
+    // Convexity: the nearest point of [0, length] to a minimiser minimises f over it.
+    return {std::sqrt(squared(std::min(std::max(best, 0.0), length))), std::sqrt(squared(best))};
 }
 
 }  // namespace vrl

@@ -21,7 +21,8 @@ double distanceLineSegment(const Vec3& origin, const Vec3& direction, const Vec3
 // Distances from a box to the segment [origin, origin + length direction] and to
 // its whole line, exactly: the squared distance to the box is a convex piecewise
 // quadratic in the line's parameter (one piece between consecutive slab
-// crossings), minimised piece by piece. Infinite for an empty box.
+// crossings); the piece where its slope turns non-negative holds the line's
+// minimiser t*, and the segment's is t* clamped to [0, length]. Infinite for an empty box.
 struct SegmentBoxDistances {
     double segment = 0.0, line = 0.0;
 };

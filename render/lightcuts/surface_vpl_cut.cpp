@@ -107,7 +107,7 @@ Rgb SurfaceVplLightcutsEstimator::bound(int32_t index, const CameraSegment& segm
     const double dLine = distances.line - slack, dSegment = distances.segment - slack;
     double geometry = std::numeric_limits<double>::infinity();
     // The angle a segment of length S subtends from distance h is at most 2 atan(S / 2h) (<= pi).
-    if (dLine > 0.0) geometry = 2.0 * std::atan(double(segment.length) / (2.0 * dLine)) / dLine;
+    if (dLine > 0.0) geometry = maxSubtendedAngle(segment.length, dLine) / dLine;
     if (dSegment > 0.0) geometry = std::min(geometry, double(segment.length) / (dSegment * dSegment));
     if (!std::isfinite(geometry)) return Rgb(std::numeric_limits<float>::infinity());
     // The cosine at y (surface_vpl_cut.h), for nodes of Lambertian VPLs with nearly one normal.
