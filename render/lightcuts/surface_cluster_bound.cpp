@@ -108,7 +108,6 @@ Rgb SurfaceClusterBound::bound(int32_t index, const CameraPathSurface& x, bool* 
     } else {
         // Glossy: the largest f|cos| towards the box's corners, its centre and its
         // point nearest the mirror direction (where a lobe peaks), with a margin (a heuristic).
-        const ShadingPoint sp = x.hit.shadingPoint();
         const Vec3 n = x.hit.shadingNormal * (x.wo.dot(x.hit.shadingNormal) >= 0.0f ? 1.0f : -1.0f);
         const Vec3 mirror = n * (2.0f * x.wo.dot(n)) - x.wo;
         const float along = std::max(0.0f, mirror.dot(node.box.center() - p));
@@ -126,7 +125,7 @@ Rgb SurfaceClusterBound::bound(int32_t index, const CameraPathSurface& x, bool* 
             const Vec3 to = q - p;
             const float length = to.length();
             if (!(length > 0.0f)) continue;
-            const Rgb f = bsdf.eval(sp, x.wo, to / length, TransportMode::Radiance);
+            const Rgb f = x.bsdf.eval(to / length, TransportMode::Radiance);
             for (int c = 0; c < 3; ++c) largest[c] = std::max(largest[c], f[c]);
         }
         fCos = largest * settings_.glossyMargin;

@@ -33,16 +33,8 @@ float safeDiv(float a, float b) { return b != 0.0f ? a / b : 0.0f; }
 
 Rgb finiteOrBlack(const Rgb& c) { return isFinite(c) ? c : Rgb(0.0f); }
 
-// The model-independent part of a query: the shading frame and wo in it.
-struct Setup {
-    Frame frame;        // shading frame, flipped to wo's side for two-sided models
-    Vec3 ng;            // geometric normal, flipped likewise
-    Vec3 woLocal;
-    float cosWoGeometric = 0.0f;  // wo . ng, non-zero
-};
-
-std::optional<Setup> makeSetup(const ShadingPoint& sp, const Vec3& wo, bool twoSided, bool transmits) {
-    Setup s;
+std::optional<BsdfSetup> makeSetup(const ShadingPoint& sp, const Vec3& wo, bool twoSided, bool transmits) {
+    BsdfSetup s;
     s.ng = sp.geometricNormal;
     Vec3 ns = sp.shadingNormal;
     s.cosWoGeometric = wo.dot(s.ng);
@@ -64,14 +56,14 @@ std::optional<Setup> makeSetup(const ShadingPoint& sp, const Vec3& wo, bool twoS
 }
 
 // wi must lie on the same side of both normals, and on wo's side unless the model transmits.
-bool validWi(const Setup& s, const Vec3& wi, const Vec3& wiLocal, bool transmits) {
+bool validWi(const BsdfSetup& s, const Vec3& wi, const Vec3& wiLocal, bool transmits) {
     const float cosWiGeometric = wi.dot(s.ng);
     if (!(wiLocal.z * cosWiGeometric > 0.0f)) return false;
     return transmits || cosWiGeometric > 0.0f;
 }
 
 // Importance transport: |wo.ns| |wi.ng| / (|wo.ng| |wi.ns|) (Veach 1997, eq. 5.19).
-float adjointFactor(const Setup& s, const Vec3& wi, const Vec3& wiLocal, TransportMode mode) {
+float adjointFactor(const BsdfSetup& s, const Vec3& wi, const Vec3& wiLocal, TransportMode mode) {
     if (mode == TransportMode::Radiance) return 1.0f;
     return safeDiv(std::abs(s.woLocal.z) * std::abs(wi.dot(s.ng)), std::abs(s.cosWoGeometric) * std::abs(wiLocal.z));
 }
@@ -200,7 +192,38 @@ float Bsdf::plasticSpecularProbability(float cosThetaO) const {
     return s + d > 0.0f ? s / (s + d) : 0.0f;
 }
 
-Rgb Bsdf::evalLocal(const Vec3& wo, const Vec3& wi, const Vec2& uv, TransportMode mode) const {
+BsdfLookups Bsdf::lookups(const Vec2& uv, const Vec3& woLocal) const {
+    BsdfLookups l;
+    switch (kind_) {
+    case Kind::Null:
+    case Kind::Dielectric:
+    case Kind::Conductor:
+        break;
+    case Kind::Diffuse:
+        l.diffuse = reflectance_.eval(uv);
+        break;
+    case Kind::Plastic:
+    case Kind::RoughPlastic:
+        l.diffuse = plasticDiffuse(uv);
+        l.fresnelWo = fresnelDielectric(woLocal.z, eta_).reflectance;
+        if (kind_ == Kind::RoughPlastic) l.specular = specularReflectance_.eval(uv);
+        break;
+    case Kind::RoughConductor:
+        l.specular = specularReflectance_.eval(uv);
+        break;
+    case Kind::Ward:
+        l.diffuse = reflectance_.eval(uv);
+        l.specular = specularReflectance_.eval(uv);
+        break;
+    case Kind::RoughDielectric:
+        l.specular = specularReflectance_.eval(uv);
+        l.transmission = specularTransmittance_.eval(uv);
+        break;
+    }
+    return l;
+}
+
+Rgb Bsdf::evalLocal(const Vec3& wo, const Vec3& wi, const BsdfLookups& l, TransportMode mode) const {
     const MicrofacetDistribution dist(distribution_, alphaU_, alphaV_);
     switch (kind_) {
     case Kind::Null:
@@ -208,18 +231,18 @@ Rgb Bsdf::evalLocal(const Vec3& wo, const Vec3& wi, const Vec2& uv, TransportMod
     case Kind::Conductor:
         return Rgb(0.0f);
     case Kind::Diffuse:
-        return reflectance_.eval(uv) * (kInvPi * wi.z);
+        return l.diffuse * (kInvPi * wi.z);
     case Kind::Plastic:
     case Kind::RoughPlastic: {
         // Diffuse base seen through the coating: (1 - F(wo)) (1 - F(wi)) / eta^2. For
         // roughplastic this is the smooth-coating approximation of Mitsuba's rough
         // transmittance tables.
-        const float fo = fresnelDielectric(wo.z, eta_).reflectance, fi = fresnelDielectric(wi.z, eta_).reflectance;
-        Rgb result = plasticDiffuse(uv) * ((1.0f - fo) * (1.0f - fi) * wi.z * kInvPi / (eta_ * eta_));
+        const float fo = l.fresnelWo, fi = fresnelDielectric(wi.z, eta_).reflectance;
+        Rgb result = l.diffuse * ((1.0f - fo) * (1.0f - fi) * wi.z * kInvPi / (eta_ * eta_));
         if (kind_ == Kind::RoughPlastic) {
             const Vec3 h = (wo + wi).normalized();
             const float f = fresnelDielectric(wo.dot(h), eta_).reflectance;
-            result += specularReflectance_.eval(uv) * (f * dist.D(h) * dist.G(wo, wi, h) / (4.0f * wo.z));
+            result += l.specular * (f * dist.D(h) * dist.G(wo, wi, h) / (4.0f * wo.z));
         }
         return result;
     }
@@ -227,13 +250,10 @@ Rgb Bsdf::evalLocal(const Vec3& wo, const Vec3& wi, const Vec2& uv, TransportMod
         const Vec3 h = (wo + wi).normalized();
         const float dg = dist.D(h) * dist.G(wo, wi, h);
         if (dg <= 0.0f) return Rgb(0.0f);
-        return specularReflectance_.eval(uv) * fresnelConductor(wo.dot(h), conductorEta_, conductorK_) *
-               (dg / (4.0f * wo.z));
+        return l.specular * fresnelConductor(wo.dot(h), conductorEta_, conductorK_) * (dg / (4.0f * wo.z));
     }
     case Kind::Ward:
-        return (reflectance_.eval(uv) * kInvPi +
-                specularReflectance_.eval(uv) * wardSpecular(wardVariant_, wo, wi, alphaU_, alphaV_)) *
-               wi.z;
+        return (l.diffuse * kInvPi + l.specular * wardSpecular(wardVariant_, wo, wi, alphaU_, alphaV_)) * wi.z;
     case Kind::RoughDielectric: {
         // Walter et al. 2007, eqs. 20 and 21; etaRatio = eta(wi side) / eta(wo side).
         const bool reflection = wo.z * wi.z > 0.0f;
@@ -246,13 +266,13 @@ Rgb Bsdf::evalLocal(const Vec3& wo, const Vec3& wi, const Vec2& uv, TransportMod
         if (dg <= 0.0f) return Rgb(0.0f);
         const float cosOH = wo.dot(h), cosIH = wi.dot(h);
         const float f = fresnelDielectric(cosOH, eta_).reflectance;
-        if (reflection) return specularReflectance_.eval(uv) * (f * dg / (4.0f * std::abs(wo.z)));
+        if (reflection) return l.specular * (f * dg / (4.0f * std::abs(wo.z)));
         const float denom = cosOH + etaRatio * cosIH;
         float value = (1.0f - f) * dg * etaRatio * etaRatio * std::abs(cosIH * cosOH) /
                       (std::abs(wo.z) * denom * denom);
         // Radiance is compressed by (eta_wo / eta_wi)^2 when it crosses the boundary.
         if (mode == TransportMode::Radiance) value /= etaRatio * etaRatio;
-        return specularTransmittance_.eval(uv) * value;
+        return l.transmission * value;
     }
     }
     return Rgb(0.0f);
@@ -298,18 +318,31 @@ float Bsdf::pdfLocal(const Vec3& wo, const Vec3& wi) const {
     return 0.0f;
 }
 
+PreparedBsdf Bsdf::prepare(const ShadingPoint& sp, const Vec3& wo) const {
+    PreparedBsdf prepared;
+    if (isNull() || isPurelySpecular()) return prepared;
+    const std::optional<BsdfSetup> s = makeSetup(sp, wo, twoSided_, transmits());
+    if (!s) return prepared;
+    prepared.bsdf_ = this;
+    prepared.setup_ = *s;
+    prepared.lookups_ = lookups(sp.uv, s->woLocal);
+    return prepared;
+}
+
+Rgb PreparedBsdf::eval(const Vec3& wi, TransportMode mode) const {
+    if (!bsdf_) return Rgb(0.0f);
+    const Vec3 wiLocal = setup_.frame.toLocal(wi);
+    if (!validWi(setup_, wi, wiLocal, bsdf_->transmits())) return Rgb(0.0f);
+    return finiteOrBlack(bsdf_->evalLocal(setup_.woLocal, wiLocal, lookups_, mode) * adjointFactor(setup_, wi, wiLocal, mode));
+}
+
 Rgb Bsdf::eval(const ShadingPoint& sp, const Vec3& wo, const Vec3& wi, TransportMode mode) const {
-    if (isNull() || isPurelySpecular()) return Rgb(0.0f);
-    const std::optional<Setup> s = makeSetup(sp, wo, twoSided_, transmits());
-    if (!s) return Rgb(0.0f);
-    const Vec3 wiLocal = s->frame.toLocal(wi);
-    if (!validWi(*s, wi, wiLocal, transmits())) return Rgb(0.0f);
-    return finiteOrBlack(evalLocal(s->woLocal, wiLocal, sp.uv, mode) * adjointFactor(*s, wi, wiLocal, mode));
+    return prepare(sp, wo).eval(wi, mode);
 }
 
 float Bsdf::pdf(const ShadingPoint& sp, const Vec3& wo, const Vec3& wi) const {
     if (isNull() || isPurelySpecular()) return 0.0f;
-    const std::optional<Setup> s = makeSetup(sp, wo, twoSided_, transmits());
+    const std::optional<BsdfSetup> s = makeSetup(sp, wo, twoSided_, transmits());
     if (!s) return 0.0f;
     const Vec3 wiLocal = s->frame.toLocal(wi);
     if (!validWi(*s, wi, wiLocal, transmits())) return 0.0f;
@@ -320,7 +353,7 @@ float Bsdf::pdf(const ShadingPoint& sp, const Vec3& wo, const Vec3& wi) const {
 std::optional<BsdfSample> Bsdf::sample(const ShadingPoint& sp, const Vec3& wo, const Vec2& u, float uLobe,
                                        TransportMode mode) const {
     if (isNull()) return BsdfSample{-wo, Rgb(1.0f), 1.0f, true};  // pass straight through
-    const std::optional<Setup> s = makeSetup(sp, wo, twoSided_, transmits());
+    const std::optional<BsdfSetup> s = makeSetup(sp, wo, twoSided_, transmits());
     if (!s) return std::nullopt;
     const Vec3& woL = s->woLocal;
     const Vec2& uv = sp.uv;
@@ -399,7 +432,7 @@ std::optional<BsdfSample> Bsdf::sample(const ShadingPoint& sp, const Vec3& wo, c
     result.pdf = pdfLocal(woL, wiLocal);
     if (!(result.pdf > 0.0f) || !std::isfinite(result.pdf)) return std::nullopt;
     const float scale = adjointFactor(*s, result.wi, wiLocal, mode) / result.pdf;
-    result.weight = finiteOrBlack(evalLocal(woL, wiLocal, uv, mode) * scale);
+    result.weight = finiteOrBlack(evalLocal(woL, wiLocal, lookups(uv, woL), mode) * scale);
     return result;
 }
 

@@ -44,6 +44,41 @@ struct BsdfSample {
     bool delta = false;  // a Dirac (specular) lobe was sampled
 };
 
+class Bsdf;
+
+// The model-independent part of a query: the shading frame and wo in it.
+struct BsdfSetup {
+    Frame frame;        // shading frame, flipped to wo's side for two-sided models
+    Vec3 ng;            // geometric normal, flipped likewise
+    Vec3 woLocal;
+    float cosWoGeometric = 0.0f;  // wo . ng, non-zero
+};
+
+// What a model's eval reads besides wo and wi: its textures at uv (those it uses)
+// and, for plastics, the Fresnel reflectance at wo.
+struct BsdfLookups {
+    Rgb diffuse{0.0f};   // reflectance (diffuse, ward) or the plastic base (plasticDiffuse)
+    Rgb specular{0.0f};  // specular reflectance (rough plastic, rough conductor, ward, rough dielectric)
+    Rgb transmission{0.0f};  // specular transmittance (rough dielectric)
+    float fresnelWo = 0.0f;  // plastics: F(wo.z)
+};
+
+// A BSDF at one point for one wo, with everything that depends on them alone
+// (setup, textures, F(wo)) done once: eval(wi, mode) == Bsdf::eval(sp, wo, wi, mode)
+// bit for bit (Bsdf::eval is prepare + eval). For callers that evaluate one
+// point against many wi: VRL-lit surfaces, a cut's bounds.
+class PreparedBsdf {
+public:
+    PreparedBsdf() = default;  // black for every wi
+    Rgb eval(const Vec3& wi, TransportMode mode) const;
+
+private:
+    friend class Bsdf;
+    const Bsdf* bsdf_ = nullptr;  // null: wo is grazing, behind a one-sided model, or the model has no non-Dirac lobe
+    BsdfSetup setup_;
+    BsdfLookups lookups_;
+};
+
 class Bsdf {
 public:
     // The default is Mitsuba's default material: diffuse, reflectance 0.5, one-sided.
@@ -62,6 +97,7 @@ public:
     bool twoSided() const { return twoSided_; }
 
     Rgb eval(const ShadingPoint& sp, const Vec3& wo, const Vec3& wi, TransportMode mode) const;
+    PreparedBsdf prepare(const ShadingPoint& sp, const Vec3& wo) const;
     float pdf(const ShadingPoint& sp, const Vec3& wo, const Vec3& wi) const;
     // u: two uniforms for the direction, uLobe: one for the choice of lobe.
     std::optional<BsdfSample> sample(const ShadingPoint& sp, const Vec3& wo, const Vec2& u, float uLobe,
@@ -78,13 +114,15 @@ public:
 private:
     // Local-frame models (bsdf.cpp): wo, wi in the shading frame, already checked
     // against the geometric sides (both z > 0 for the reflection models).
-    Rgb evalLocal(const Vec3& wo, const Vec3& wi, const Vec2& uv, TransportMode mode) const;
+    Rgb evalLocal(const Vec3& wo, const Vec3& wi, const BsdfLookups& lookups, TransportMode mode) const;
+    BsdfLookups lookups(const Vec2& uv, const Vec3& woLocal) const;
     float pdfLocal(const Vec3& wo, const Vec3& wi) const;
     // Plastic models: diffuse base colour with the internal-reflection term, and the
     // probability of sampling the specular lobe for wo.z = cosThetaO.
     Rgb plasticDiffuse(const Vec2& uv) const;
     float plasticSpecularProbability(float cosThetaO) const;
     bool transmits() const;
+    friend class PreparedBsdf;
 
     BsdfDescription::Kind kind_ = BsdfDescription::Kind::Diffuse;
     TexturedColor reflectance_{Rgb(0.5f), nullptr};

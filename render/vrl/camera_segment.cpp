@@ -10,6 +10,12 @@ std::vector<CameraSegment> cameraSegments(const Scene& scene, const Ray& cameraR
     return cameraPath(scene, cameraRay, medium, rng, maxDepth).segments;
 }
 
+CameraPathSurface cameraPathSurface(const Scene& scene, const SurfaceHit& hit, const Vec3& wo, int medium,
+                                    const Rgb& throughput, int specularBefore) {
+    return CameraPathSurface{hit, wo, medium, throughput, specularBefore,
+                             scene.shapes()[hit.shape].bsdf.prepare(hit.shadingPoint(), wo)};
+}
+
 CameraPath cameraPath(const Scene& scene, const Ray& cameraRay, int medium, Rng* rng, int maxDepth) {
     CameraPath path;
     std::vector<CameraSegment>& segments = path.segments;
@@ -40,7 +46,7 @@ CameraPath cameraPath(const Scene& scene, const Ray& cameraRay, int medium, Rng*
         if (!bsdf.isPurelySpecular()) {
             // A surface flush with the boundary just crossed is met from the medium before it.
             const int arrival = Scene::withinCrossing(ray, *hit) ? mediumBeforeCrossing : medium;
-            path.surface = CameraPathSurface{*hit, -ray.direction, arrival, throughput, specular};
+            path.surface = cameraPathSurface(scene, *hit, -ray.direction, arrival, throughput, specular);
             break;
         }
         if (!rng || specular >= kMaxSpecularChain) break;

@@ -44,7 +44,14 @@ struct CameraPathSurface {
     int medium = -1;  // the medium the path arrives in (on wo's side)
     Rgb throughput{1.0f};  // transmittance and specular weights from the camera to the surface
     int specularBefore = 0;
+    // x's BSDF prepared for wo (Bsdf::prepare): (c)'s estimator and bound evaluate it
+    // against many directions. cameraPathSurface fills it.
+    PreparedBsdf bsdf;
 };
+
+// A camera path's surface vertex with its BSDF prepared.
+CameraPathSurface cameraPathSurface(const Scene& scene, const SurfaceHit& hit, const Vec3& wo, int medium,
+                                    const Rgb& throughput, int specularBefore);
 
 struct CameraPath {
     std::vector<CameraSegment> segments;

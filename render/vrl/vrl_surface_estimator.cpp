@@ -27,8 +27,7 @@ Rgb VrlSurfaceEstimator::sampleOnce(const Vrl& vrl, const CameraPathSurface& x, 
     if (!(r2 > 0.0f)) return Rgb(0.0f);
     const float r = std::sqrt(r2);
     const Vec3 wi = toV / r;
-    const Bsdf& bsdf = scene_.shapes()[x.hit.shape].bsdf;
-    const Rgb f = bsdf.eval(x.hit.shadingPoint(), x.wo, wi, TransportMode::Radiance);
+    const Rgb f = x.bsdf.eval(wi, TransportMode::Radiance);
     if (isBlack(f)) return Rgb(0.0f);
     const HomogeneousMedium& medium = scene_.media()[vrl.medium];
     const float phase = medium.phase().eval(vrl.direction, -wi);

@@ -125,7 +125,7 @@ std::optional<CameraPathSurface> randomSurfacePoint(const Scene& scene, Rng& rng
     const Vec3 dir = (target - eye).normalized();
     const auto hit = scene.intersect(Ray{eye, dir});
     if (!hit) return std::nullopt;
-    return CameraPathSurface{*hit, -dir, 0, Rgb(0.3f + 0.7f * rng.next()), 0};
+    return cameraPathSurface(scene, *hit, -dir, 0, Rgb(0.3f + 0.7f * rng.next()), 0);
 }
 
 double channelSum(const Rgb& c) { return double(c.x) + c.y + c.z; }

@@ -114,7 +114,7 @@ Tally checkBound(const Scene& scene, uint64_t seed, int vrlCount, int points) {
         const Vec3 target = direction(rng) * 0.9f;
         const auto hit = scene.intersect(Ray{eye, (target - eye).normalized()});
         if (!hit) continue;
-        const CameraPathSurface x{*hit, -(target - eye).normalized(), 0, Rgb(0.3f + 0.7f * rng.next()), 0};
+        const CameraPathSurface x = cameraPathSurface(scene, *hit, -(target - eye).normalized(), 0, Rgb(0.3f + 0.7f * rng.next()), 0);
         for (int32_t node = 0; node < int32_t(tree.nodes().size()); ++node) {
             const LightTreeNode& n = tree.nodes()[node];
             bool inside = false;

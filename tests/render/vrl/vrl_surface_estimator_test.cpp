@@ -59,7 +59,7 @@ CameraPathSurface surfacePoint(const Scene& scene, const Vec3& onPlane, const Ve
     const Vec3 to = (onPlane - eye).normalized();
     const auto hit = scene.intersect(Ray{eye, to});
     EXPECT_TRUE(hit.has_value());
-    return CameraPathSurface{*hit, -to, 0, throughput, 0};
+    return cameraPathSurface(scene, *hit, -to, 0, throughput, 0);
 }
 
 V3d quadrature(const Vrl& vrl, const CameraPathSurface& x, const Medium& m, int panels) {
