@@ -15,6 +15,7 @@
 #include <cmath>
 #include <cstdint>
 #include <filesystem>
+#include <mutex>
 #include <stdexcept>
 #include <string>
 #include <system_error>
@@ -180,6 +181,13 @@ std::shared_ptr<const Texture> Texture::load(const TextureDescription& descripti
     if (!std::filesystem::exists(description.filename, ec)) throw fail("file not found");
     if (std::filesystem::is_directory(description.filename, ec)) throw fail("is a directory, not an image");
 
+    // One decode at a time in the process: OpenImageIO 2.4's ImageInput::open is not
+    // thread-safe for JPEG files (OpenImageIO issue #3756: a staircase load crashed
+    // in it about once in twenty while another thread decoded a JPEG). Scene::build
+    // loads its textures in turn; the lock also covers scenes built concurrently
+    // (a worker's jobs). The library's own state is process-wide, so is this guard.
+    static std::mutex decodeMutex;
+    const std::lock_guard<std::mutex> decoding(decodeMutex);
     // Colour as stored, not multiplied by alpha (which is dropped).
     OIIO::ImageSpec config;
     config.attribute("oiio:UnassociatedAlpha", 1);

@@ -5,7 +5,6 @@
 #include <Imath/ImathBox.h>
 #include <embree3/rtcore.h>
 #include <spdlog/spdlog.h>
-#include <tbb/parallel_for.h>
 
 #include <algorithm>
 #include <cmath>
@@ -147,10 +146,9 @@ std::unique_ptr<Scene> Scene::build(const SceneDescription& declared) {
             throw SceneError(where, "medium index " + std::to_string(index) + " out of range");
     };
     checkMedium(description.sensor.medium, description.sensor.where);
-    scene->textures_.resize(description.textures.size());
-    tbb::parallel_for(size_t(0), description.textures.size(), [&](size_t i) {
-        scene->textures_[i] = Texture::load(description.textures[i]);
-    });
+    // In turn: OpenImageIO 2.4 cannot open JPEG files concurrently (Texture::load).
+    scene->textures_.reserve(description.textures.size());
+    for (const TextureDescription& texture : description.textures) scene->textures_.push_back(Texture::load(texture));
     for (const auto& note : description.approximations) spdlog::warn("approximation: {}", note);
     scene->shapes_.reserve(description.shapes.size());
     for (const auto& s : description.shapes) {
