@@ -129,9 +129,12 @@ SegmentBoxDistances distancesSegmentBox(const Vec3& origin, const Vec3& directio
     int k = 0;
     while (k < count && slope(breaks[k]) < 0.0) ++k;
     const double from = k > 0 ? breaks[k - 1] : -kInf, to = k < count ? breaks[k] : kInf;
-    // On it f = A t^2 + B t + C with the axes outside the box at its middle.
-    const double mid = std::isfinite(from) && std::isfinite(to) ? 0.5 * (from + to) : std::isfinite(from) ? from + 1.0
-                                                                                     : std::isfinite(to) ? to - 1.0 : 0.0;
+    // On it f = A t^2 + B t + C with the axes outside the box at a point inside it (a
+    // step of 1 + |end| past a far end, which a step of 1 would not leave in double).
+    const double mid = std::isfinite(from) && std::isfinite(to) ? 0.5 * (from + to)
+                       : std::isfinite(from)                    ? from + (1.0 + std::abs(from))
+                       : std::isfinite(to)                      ? to - (1.0 + std::abs(to))
+                                                                : 0.0;
     double A = 0.0, B = 0.0;
     for (int a = 0; a < 3; ++a) {
         const double x = o[a] + mid * d[a];

@@ -17,10 +17,12 @@
 // contribution; h_min <= distance between the node's VRLs and the camera line
 // (their box's, their segments' for small nodes, or optionally their bounding
 // sphere's when it is far: ClusterBoundSettings::sphereDistanceBeyond; less a
-// few float steps, for the rounding of sample points). Transmittance: in a medium
-// whose boundary is convex, holding the node's VRLs, T(u) T_r(w) = exp(-sigma_t (u + w))
-// and u + w >= |origin - v| >= d_o, the distance from the segment's origin to the
-// box (>= h_min), so it is bounded by T(d_o); elsewhere by 1, as is visibility. A line through the node's box (h_min = 0) gives an infinite
+// few float steps, for the rounding of sample points). Transmittance: in a
+// medium whose boundary is convex, holding the node's VRLs,
+// T(u) T_r(w) = exp(-sigma_t (u + w)) and u + w >= |origin - v| >= d_o, the
+// distance from the segment's origin to the box (>= h_min), so it is bounded by
+// T(d_o) (floored at 1e-30 against underflow); elsewhere by 1, as is
+// visibility. A line through the node's box (h_min = 0) gives an infinite
 // bound: the node is always refined.
 //
 // Henyey-Greenstein media (HgBound::Cones, proven). Two things change: the

@@ -30,8 +30,7 @@
 // shape that bounds no medium (the proxy's medium, else -1) and that medium's
 // boundary is convex, u -> y stays in it, so T_m(t) T_r = exp(-sigma_t (t + r))
 // with t + r >= |o - y| >= d_o, the distance from the segment's origin o to B:
-// the bound takes the factor T(d_o). G uses 2 atan(S / 2 d_l) / d_l, the
-// largest angle the segment subtends from distance d_l, not pi / d_l.
+// the bound takes the factor T(d_o) (floored at 1e-30 against underflow).
 // The cosine at y, where every VPL of the node has a Lambertian bound and their
 // geometric normals n_k lie within eps of one axis a (|n_k - a| <= eps: a floor, a
 // wall): for Lambertian-bounded models f_s = F_k |w.n_g| at most (the importance-mode
