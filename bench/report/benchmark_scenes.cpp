@@ -55,9 +55,9 @@ std::vector<MethodRun> sweep(bool quick) {
     // mostly parts (a) and (b), path-sampled alike by every virtual-light method, so
     // fewer samples move every curve alike and keep them above the noise rule's floor.
     // (Since part (b)'s surface light comes from surface VPLs in plain VRLs and VRL
-    // Lightcuts, their whole-image runs cost x1.1-3.0 more and err x0.3-1.0 less: the
-    // full report took 49.4 min, and four veach-lamp runs fell below its reference's
-    // noise. Not yet rebalanced.)
+    // Lightcuts, their whole-image runs err x0.3-1.0 less, and four veach-lamp runs
+    // fall below its reference's noise; with the tighter bounds and faster kernels
+    // after them the full report took 44.9 min, 49.4 before.)
     // Each curve spans an order of magnitude in time or more: the spp grow with N,
     // and each curve starts at a cheap point (on bathroom 1-3 s: plain VRLs and VRL
     // Lightcuts at N = 100, stochastic cuts N = 1k, all at 1 spp, VPL Lightcuts at
