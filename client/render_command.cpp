@@ -231,9 +231,15 @@ int runRender(const RenderCommandOptions& o, const CLI::App& command) {
             std::fprintf(stderr, "  %d independent VRL sets (counts above are over all of them); sample s uses set s mod %d\n",
                          settings.vrlSets, settings.vrlSets);
         std::fprintf(stderr, "  transport parts: %s\n", settings.transports.toString().c_str());
-        if (usesSurfaceVpls(settings))
+        if (usesSurfaceVpls(settings) && stats.surfaceVplPaths < stats.lightPaths)
+            std::fprintf(stderr, "  (b) surface light from %llu surface VPLs of the first %llu of the same light paths "
+                         "(limit %llu)\n", (unsigned long long)stats.surfaceVplCount,
+                         (unsigned long long)stats.surfaceVplPaths, (unsigned long long)surfaceVplLimit(settings));
+        else if (usesSurfaceVpls(settings))
             std::fprintf(stderr, "  (b) surface light from %llu surface VPLs of the same light paths\n",
                          (unsigned long long)stats.surfaceVplCount);
+        else if (settings.surfaceVplLimit == 0 && settings.transports.has(TransportPart::Single))
+            std::fprintf(stderr, "  (b) surface light path-sampled (--surface-vpls 0)\n");
     }
     if (usesLightTree(settings.method)) {
         std::fprintf(stderr, "  light tree %.3f s, %.1f MiB\n", stats.treeSeconds,

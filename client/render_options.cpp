@@ -126,6 +126,11 @@ void addRenderOptions(CLI::App& cmd, RenderCommandOptions& o) {
                    "(by a cut for vpl-lightcuts); their cost grows with it, the noise of the distance sampling "
                    "falls (default " + std::to_string(kDefaultVplDistanceSamples) + ")")
         ->check(CLI::Range(1u, uint32_t(kMaxVplDistanceSamples)));
+    cmd.add_option("--surface-vpls", o.surfaceVpls,
+                   "vrl, vrl-lightcuts: the most surface VPLs for part (b)'s surface light, deposited by the first "
+                   "light paths until the limit (fewer paths: a noisier, not a darker, part (b)); 0: none, part (b) "
+                   "path-samples its surface light (default: as many as --vrls, or 4 per light path)")
+        ->check(CLI::Range(uint64_t(0), uint64_t(1) << 40));
     cmd.add_flag("--pixel-centres", o.pixelCentres,
                  "Camera rays through pixel centres, the paper's setting (default: jittered inside each pixel, "
                  "antialiased, as Mitsuba and pbrt do; still bit-identical across threads and workers)");
@@ -155,6 +160,7 @@ void warnIneffectiveFlags(const CLI::App& command, RenderMethod method, bool dis
         {"--cut-size", method == RenderMethod::VrlStochastic, "vrl-stochastic"},
         {"--exact-distance-below", method == RenderMethod::VrlLightcuts, "vrl-lightcuts"},
         {"--distance-samples", usesVpls(method), "vpl and vpl-lightcuts"},
+        {"--surface-vpls", method == RenderMethod::Vrl || method == RenderMethod::VrlLightcuts, "vrl and vrl-lightcuts"},
     };
     const std::string name(methodName(method));
     for (const Rule& rule : rules)
@@ -176,7 +182,10 @@ void checkLightMemory(const RenderSettings& settings, uint64_t memoryBytes) {
                   (unsigned long long)settings.vrlCount, settings.vrlSets > 1 ? " in each VRL set" : "",
                   usesVpls(settings.method) ? "VPLs" : "VRLs", double(need) / double(1ull << 30),
                   double(need) / (double(std::max<uint64_t>(1, settings.vrlCount)) * std::max(1, settings.vrlSets)),
-                  double(memoryBytes) / double(1ull << 30), settings.vrlSets > 1 ? " or --vrl-sets" : "");
+                  double(memoryBytes) / double(1ull << 30),
+                  settings.vrlSets > 1                             ? " or --vrl-sets"
+                  : settings.surfaceVplLimit != kAutoSurfaceVpls && usesSurfaceVpls(settings) ? " or --surface-vpls"
+                                                                                  : "");
     throw std::invalid_argument(message);
 }
 
@@ -242,6 +251,8 @@ v1::RenderParameters toRenderParameters(const RenderCommandOptions& o) {
     p.set_cut_size(o.cutSize);
     p.set_vrl_sets(o.vrlSets);
     p.set_vpl_distance_samples(o.distanceSamples);
+    // The spec's -1 is none, its 0 the default.
+    if (o.surfaceVpls) p.set_surface_vpls(*o.surfaceVpls == 0 ? -1 : int64_t(*o.surfaceVpls));
     return p;
 }
 

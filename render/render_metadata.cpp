@@ -41,7 +41,14 @@ void writeRenderMetadata(const RenderRecord& record, const PerspectiveCamera& ca
         metadata[usesVpls(s.method) ? "vrl.vpls" : "vrl.vrls"] = double(stats.vrlCount);
         metadata["vrl.lightPaths"] = double(stats.lightPaths);
         metadata["vrl.time.lightTracing"] = stats.tracingSeconds;
-        if (usesSurfaceVpls(s)) metadata["vrl.surfaceVpls"] = double(stats.surfaceVplCount);
+        if (usesSurfaceVpls(s)) {
+            metadata["vrl.surfaceVpls"] = double(stats.surfaceVplCount);
+            metadata["vrl.surfaceVplLimit"] = double(surfaceVplLimit(s));
+            metadata["vrl.surfaceVplPaths"] = double(stats.surfaceVplPaths);  // the light paths that deposited them
+        } else if ((s.method == RenderMethod::Vrl || s.method == RenderMethod::VrlLightcuts) &&
+                   s.transports.has(TransportPart::Single)) {
+            metadata["vrl.surfaceVplLimit"] = 0.0;  // none: (b) path-samples its surface light
+        }
     }
     if (usesVpls(s.method)) metadata["vrl.vplDistanceSamples"] = int32_t(s.vplDistanceSamples);
     if (usesLightTree(s.method)) {

@@ -18,6 +18,8 @@
 #include <cmath>
 #include <stdexcept>
 
+#include <spdlog/spdlog.h>
+
 namespace vrl {
 
 namespace {
@@ -58,7 +60,13 @@ bool needsLights(const RenderSettings& settings) { return needsVrls(settings) ||
 
 bool usesSurfaceVpls(const RenderSettings& settings) {
     return (settings.method == RenderMethod::Vrl || settings.method == RenderMethod::VrlLightcuts) &&
-           settings.transports.has(TransportPart::Single);
+           settings.transports.has(TransportPart::Single) && settings.surfaceVplLimit > 0;
+}
+
+uint64_t surfaceVplLimit(const RenderSettings& settings) {
+    if (settings.surfaceVplLimit != kAutoSurfaceVpls) return settings.surfaceVplLimit;
+    if (settings.lightPaths > 0) return settings.lightPaths > kAutoSurfaceVpls / 4 ? kAutoSurfaceVpls : 4 * settings.lightPaths;
+    return settings.vrlCount;
 }
 
 std::string_view methodName(RenderMethod method) {
@@ -135,6 +143,7 @@ RenderLights prepareLights(const Scene& scene, const RenderSettings& settings, c
         tracing.seed = k == 0 ? firstSeed : Rng::combine(firstSeed, uint64_t(k));  // set 0: as with one set
         if (points) tracing.deposit = LightDeposit::Points;
         tracing.surfaceVpls = k == 0 && usesSurfaceVpls(settings);
+        tracing.surfaceVplLimit = surfaceVplLimit(settings);
         const std::string tracingPhase = sets == 1 ? std::string("light tracing")
                                                    : "light tracing (set " + std::to_string(k + 1) + " of " +
                                                          std::to_string(sets) + ")";
@@ -153,6 +162,11 @@ RenderLights prepareLights(const Scene& scene, const RenderSettings& settings, c
                                                     LightTreeSettings{settings.partitionSize, settings.seed});
             if (cut) stats.treeSeconds += secondsSince(treeStart);
             stats.surfaceVplCount = lights.surfaceVpls.vpls.size();
+            stats.surfaceVplPaths = set.surfaceVplPaths;
+            if (set.surfaceVplPaths < set.lightPaths)
+                spdlog::info("surface VPLs: the limit of {} was reached after {} of {} light paths; (b)'s surface "
+                             "light comes from those paths (raise --surface-vpls for less noise)",
+                             surfaceVplLimit(settings), set.surfaceVplPaths, set.lightPaths);
             stats.treeBytes += lights.surfaceVpls.tree.memoryBytes();
             set.surfaceVpls = {};
         }
@@ -203,15 +217,17 @@ uint64_t estimateLightMemoryBytes(const RenderSettings& settings) {
     if (settings.method == RenderMethod::VrlStochastic)
         perLight += double(VrlImportance::kBytesPerInnerNode);
     if (settings.method == RenderMethod::Vrl) perLight += double(VrlLanes::kBytesPerVrl);
-    // Surface VPLs (part (b)): counted as one per VRL (a light path meets about as many
-    // surfaces as it leaves segments in a medium that fills the scene), twice while
-    // traced, and for the cut its proxies, nodes and build scratch.
+    // Surface VPLs (part (b)): their limit (by default one per VRL: a light path meets
+    // about as many surfaces as it leaves segments in a medium that fills the scene),
+    // twice while traced, and for the cut its proxies, nodes and build scratch.
+    double perSurfaceVpl = 0.0;
     if (usesSurfaceVpls(settings)) {
-        perLight += 2.0 * sizeof(SurfaceVpl);
+        perSurfaceVpl = 2.0 * sizeof(SurfaceVpl);
         if (usesLightTree(settings.method))
-            perLight += sizeof(Vrl) + 2.0 * sizeof(LightTreeNode) + double(LightTree::buildScratchBytesPerVrl());
+            perSurfaceVpl += sizeof(Vrl) + 2.0 * sizeof(LightTreeNode) + double(LightTree::buildScratchBytesPerVrl());
     }
-    const double bytes = perLight * double(settings.vrlCount) * double(std::max(1, settings.vrlSets));
+    const double bytes = perLight * double(settings.vrlCount) * double(std::max(1, settings.vrlSets)) +
+                         perSurfaceVpl * double(surfaceVplLimit(settings));
     return bytes >= 1.8e19 ? ~uint64_t(0) : uint64_t(bytes);
 }
 

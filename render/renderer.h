@@ -82,6 +82,10 @@ inline constexpr int kMaxVrlSets = 1024;
 // (RenderSettings::vplDistanceSamples): each is one cut (or gather) per segment.
 inline constexpr int kMaxVplDistanceSamples = 4096;
 
+// RenderSettings::surfaceVplLimit: as many surface VPLs as the VRL target (or 4 per
+// light path with lightPaths), what estimateLightMemoryBytes counts.
+inline constexpr uint64_t kAutoSurfaceVpls = ~uint64_t(0);
+
 // The longest time limit a render takes (about 116 days): a guard against typos such as 1e30.
 inline constexpr double kMaxTimeLimitSeconds = 1e7;
 
@@ -110,6 +114,11 @@ struct RenderSettings {
     // to the true transport rather than to one set's. Set 0 is the set of vrlSets = 1:
     // with one sample per pixel the image does not depend on vrlSets.
     int vrlSets = 1;
+    // vrl, vrl-lightcuts: the most surface VPLs (part (b)'s surface light), deposited by
+    // the first light paths until the limit (LightTracingSettings::surfaceVplLimit:
+    // fewer paths make (b) noisier, not darker). 0: none, part (b) path-samples its
+    // surface light as vrl-stochastic does. kAutoSurfaceVpls: see there.
+    uint64_t surfaceVplLimit = kAutoSurfaceVpls;
 };
 
 struct RenderStatistics {
@@ -130,6 +139,7 @@ struct RenderStatistics {
     double surfaceMeanEvaluated = 0.0, surfaceMeanIntersected = 0.0, surfaceMeanCutSize = 0.0;  // part (c)
     double meanImportance = 0.0, surfaceMeanImportance = 0.0;  // vrl-stochastic: importances per pixel and sample
     uint64_t surfaceVplCount = 0;  // surface VPLs (part (b)), over the kept ones
+    uint64_t surfaceVplPaths = 0;  // the light paths that deposited them (all unless the limit was reached)
     double surfaceVplMeanEvaluated = 0.0, surfaceVplMeanIntersected = 0.0, surfaceVplMeanCutSize = 0.0;  // their cut
     uint64_t boundExceeded = 0, boundedEstimates = 0;  // inner-node estimates above their bound, (c) and (d)
 };
@@ -158,8 +168,10 @@ struct RenderLights {
 };
 
 // Whether `settings` take part (b)'s surface light from surface VPLs: vrl and
-// vrl-lightcuts with part (b) selected.
+// vrl-lightcuts with part (b) selected and a surface VPL limit above 0.
 bool usesSurfaceVpls(const RenderSettings& settings);
+// settings.surfaceVplLimit with kAutoSurfaceVpls resolved.
+uint64_t surfaceVplLimit(const RenderSettings& settings);
 RenderLights prepareLights(const Scene& scene, const RenderSettings& settings, const ProgressCallback& progress = {},
                            RenderStatistics* statistics = nullptr);
 

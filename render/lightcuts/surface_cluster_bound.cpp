@@ -100,7 +100,7 @@ Rgb SurfaceClusterBound::bound(int32_t index, const CameraPathSurface& x, bool* 
     if (reflectsOnly && signedDistanceRange(node.box, x.hit.geometricNormal * side, p).second < -slack) return Rgb(0.0f);
 
     Rgb fCos;
-    const std::optional<Rgb> lambert = bsdf.lambertianBound(x.hit.uv);
+    const std::optional<Rgb> lambert = x.bsdf.lambertianBound();  // x's lookups: no texture read per node
     if (lambert) {
         const auto [lo, hi] = signedDistanceRange(node.box, x.hit.shadingNormal, p);
         const double cosine = std::min(1.0, (std::max(std::abs(lo), std::abs(hi)) + slack) / d);

@@ -436,10 +436,21 @@ std::optional<BsdfSample> Bsdf::sample(const ShadingPoint& sp, const Vec3& wo, c
     return result;
 }
 
-std::optional<Rgb> Bsdf::lambertianBound(const Vec2& uv) const {
-    if (kind_ == Kind::Diffuse) return reflectance_.eval(uv) * kInvPi;
-    if (kind_ == Kind::Plastic) return plasticDiffuse(uv) * (kInvPi / (eta_ * eta_));
+std::optional<Rgb> Bsdf::lambertianBoundOf(const Rgb& diffuse) const {
+    if (kind_ == Kind::Diffuse) return diffuse * kInvPi;
+    if (kind_ == Kind::Plastic) return diffuse * (kInvPi / (eta_ * eta_));
     return std::nullopt;
+}
+
+std::optional<Rgb> Bsdf::lambertianBound(const Vec2& uv) const {
+    if (kind_ == Kind::Diffuse) return lambertianBoundOf(reflectance_.eval(uv));
+    if (kind_ == Kind::Plastic) return lambertianBoundOf(plasticDiffuse(uv));
+    return std::nullopt;
+}
+
+std::optional<Rgb> PreparedBsdf::lambertianBound() const {
+    if (!bsdf_) return Rgb(0.0f);
+    return bsdf_->lambertianBoundOf(lookups_.diffuse);
 }
 
 Rgb Bsdf::albedo(const Vec2& uv) const {

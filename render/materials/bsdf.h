@@ -71,6 +71,10 @@ class PreparedBsdf {
 public:
     PreparedBsdf() = default;  // black for every wi
     Rgb eval(const Vec3& wi, TransportMode mode) const;
+    // Bsdf::lambertianBound at the prepared point, from the lookups (no texture
+    // read): a bound on eval(wi) / |cos| over every wi. 0 where nothing was
+    // prepared (eval is black for every wi); empty for non-Lambertian models.
+    std::optional<Rgb> lambertianBound() const;
 
 private:
     friend class Bsdf;
@@ -121,6 +125,8 @@ private:
     // probability of sampling the specular lobe for wo.z = cosThetaO.
     Rgb plasticDiffuse(const Vec2& uv) const;
     float plasticSpecularProbability(float cosThetaO) const;
+    // lambertianBound from the model's diffuse lookup (BsdfLookups::diffuse).
+    std::optional<Rgb> lambertianBoundOf(const Rgb& diffuse) const;
     bool transmits() const;
     friend class PreparedBsdf;
 

@@ -170,7 +170,7 @@ VrlSet traceVrls(const Scene& scene, const LightTracingSettings& settings,
     VrlSet result;
     std::vector<std::vector<Vrl>> chunks(kChunksPerBatch);
     std::vector<std::vector<SurfaceVpl>> surfaceChunks(kChunksPerBatch);
-    const bool surfaceVpls = settings.surfaceVpls && settings.deposit == LightDeposit::Segments;
+    bool surfaceVpls = settings.surfaceVpls && settings.deposit == LightDeposit::Segments;  // still depositing
     uint64_t emptyBatches = 0;
     while (true) {
         const uint64_t remaining = settings.lightPaths > 0 ? settings.lightPaths - result.lightPaths : ~0ULL;
@@ -194,8 +194,16 @@ VrlSet traceVrls(const Scene& scene, const LightTracingSettings& settings,
         });
         const size_t before = result.vrls.size();
         for (const auto& chunk : chunks) result.vrls.insert(result.vrls.end(), chunk.begin(), chunk.end());
-        for (const auto& chunk : surfaceChunks)  // in chunk order: the same list on any thread count
+        for (uint64_t c = 0; surfaceVpls && c < kChunksPerBatch; ++c) {  // in chunk order: the same on any thread count
+            const auto& chunk = surfaceChunks[c];
+            const uint64_t kept = result.surfaceVpls.size();
+            if (result.surfaceVplPaths > 0 && (kept >= settings.surfaceVplLimit || chunk.size() > settings.surfaceVplLimit - kept)) {
+                surfaceVpls = false;  // this chunk would pass the limit: it and every later path deposit none
+                break;
+            }
             result.surfaceVpls.insert(result.surfaceVpls.end(), chunk.begin(), chunk.end());
+            result.surfaceVplPaths += std::min(batch, (c + 1) * kPathsPerChunk) - std::min(batch, c * kPathsPerChunk);
+        }
         result.lightPaths += batch;
         if (settings.lightPaths > 0) {
             if (progress) progress(double(result.lightPaths) / double(settings.lightPaths));
@@ -212,7 +220,8 @@ VrlSet traceVrls(const Scene& scene, const LightTracingSettings& settings,
     }
     const float scale = result.lightPaths > 0 ? 1.0f / float(result.lightPaths) : 0.0f;
     for (auto& v : result.vrls) v.flux *= scale;
-    for (auto& v : result.surfaceVpls) v.flux *= scale;
+    const float surfaceScale = result.surfaceVplPaths > 0 ? 1.0f / float(result.surfaceVplPaths) : 0.0f;
+    for (auto& v : result.surfaceVpls) v.flux *= surfaceScale;
     result.vrls.shrink_to_fit();
     result.surfaceVpls.shrink_to_fit();
     result.tracingSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

@@ -47,6 +47,14 @@ struct LightTracingSettings {
     // x1, then to the camera); like the VRLs, it is kept only where the path
     // may still continue, which gives k + 2 <= maxDepth.
     bool surfaceVpls = false;
+    // The most surface VPLs kept. Paths deposit them in order, 64 paths (a chunk) at
+    // a time, until the next chunk's would pass the limit; from there on no path
+    // deposits any, and the kept ones' flux is divided by the count of the paths
+    // that deposited them (VrlSet::surfaceVplPaths): an unbiased estimate from fewer
+    // paths, the same on any thread count. The first chunk is always kept (so that
+    // a small limit gives a noisy part (b), never a black one). Bounds their memory
+    // where paths meet many surfaces per VRL (a thin or small medium).
+    uint64_t surfaceVplLimit = ~uint64_t(0);
 };
 
 // Throws std::invalid_argument if both lightPaths and targetVrls are 0.

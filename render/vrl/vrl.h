@@ -32,9 +32,12 @@ struct Vrl {
 struct VrlSet {
     std::vector<Vrl> vrls;
     // Surface VPLs of the same light paths (LightTracingSettings::surfaceVpls), flux
-    // divided by the path count like the VRLs'; empty unless asked for.
+    // divided by surfaceVplPaths (the VRLs': by lightPaths); empty unless asked for.
     std::vector<SurfaceVpl> surfaceVpls;
     uint64_t lightPaths = 0;  // light paths traced (the flux normalisation)
+    // The first light paths that deposited the surface VPLs (their flux normalisation):
+    // all of them unless LightTracingSettings::surfaceVplLimit was reached.
+    uint64_t surfaceVplPaths = 0;
     double tracingSeconds = 0.0;
     size_t memoryBytes() const { return vrls.capacity() * sizeof(Vrl) + surfaceVpls.capacity() * sizeof(SurfaceVpl); }
 };

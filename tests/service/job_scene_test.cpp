@@ -176,6 +176,42 @@ TEST(ResolveJob, VplDistanceSamplesComeFromTheSpec) {
     }
 }
 
+// The surface VPL limit travels in the spec: 0 the default, -1 none (the render
+// then path-samples part (b)'s surface light), N a limit up to the coordinator's
+// light limit; anything else is refused before any work.
+TEST(ResolveJob, SurfaceVplLimitComesFromTheSpec) {
+    const test::TempDir dir("vrl-job-scene");
+    const auto scene = writeScene(dir, "");
+    v1::JobSpec spec = specWithMethod("vrl-lightcuts");
+    EXPECT_EQ(rpc::defaultRenderParameters(RenderMethod::VrlLightcuts).surface_vpls(), 0);
+    RenderSettings settings = rpc::resolveJob(scene, spec, {}).settings;
+    EXPECT_EQ(settings.surfaceVplLimit, kAutoSurfaceVpls);
+    EXPECT_EQ(surfaceVplLimit(settings), settings.vrlCount);
+    EXPECT_TRUE(usesSurfaceVpls(settings));
+    spec.mutable_parameters()->set_surface_vpls(-1);
+    settings = rpc::resolveJob(scene, spec, {}).settings;
+    EXPECT_EQ(settings.surfaceVplLimit, 0u);
+    EXPECT_FALSE(usesSurfaceVpls(settings));
+    spec.mutable_parameters()->set_surface_vpls(5000);
+    settings = rpc::resolveJob(scene, spec, {}).settings;
+    EXPECT_EQ(surfaceVplLimit(settings), 5000u);
+    EXPECT_TRUE(usesSurfaceVpls(settings));
+    spec.mutable_parameters()->set_vrl_count(1000);
+    rpc::ServiceLimits limits;
+    limits.maxVrls = 4000;
+    for (const auto& [value, limit] : {std::pair<int64_t, rpc::ServiceLimits>{-2, {}}, {5000, limits}}) {
+        spec.mutable_parameters()->set_surface_vpls(value);
+        try {
+            rpc::validateJobSpec(spec, limit);
+            ADD_FAILURE() << "surface VPLs " << value << " accepted";
+        } catch (const rpc::JobSpecError& e) {
+            EXPECT_NE(std::string(e.what()).find("surface VPLs must be -1 (none), 0 (the default) or 1..."),
+                      std::string::npos)
+                << e.what();
+        }
+    }
+}
+
 TEST(ResolveJob, CropAppliesAfterTheResolution) {
     const test::TempDir dir("vrl-job-scene");
     const auto scene = writeScene(dir, "");

@@ -221,6 +221,32 @@ TEST(Service, SurfaceVplsAloneAreShippedAndShadeBitIdentically) {
     }
 }
 
+// The job's surface VPL limit reaches the coordinator, which traces them: -1 ships
+// none and the workers path-sample part (b)'s surface light (no single-vpl layer);
+// a small limit ships the first paths' VPLs (here one chunk's: 64 paths). Both shade bit-identically to the
+// embedded render and record the limit in the EXR.
+TEST(Service, SurfaceVplLimitReachesTheCoordinatorAndTheWorkers) {
+    Cluster cluster;
+    cluster.startWorker("a");
+    for (const int64_t limit : {int64_t(-1), int64_t(100)}) {
+        SCOPED_TRACE(limit);
+        v1::JobSpec spec = makeSpec("vrl-lightcuts", 1, 9, 16, 12, 8);
+        spec.mutable_parameters()->set_vrl_count(800);
+        spec.mutable_parameters()->set_surface_vpls(limit);
+        const ImageSet image = cluster.waitForImage(cluster.submit(spec));
+        expectBitIdentical(embeddedRender(spec), image);
+        const bool hasLayer = std::any_of(image.layers.begin(), image.layers.end(),
+                                          [](const auto& entry) { return entry.first == kSurfaceVplLayerName; });
+        EXPECT_EQ(hasLayer, limit > 0);
+        EXPECT_EQ(std::get<double>(image.metadata.at("vrl.surfaceVplLimit")), limit > 0 ? double(limit) : 0.0);
+        if (limit > 0) {
+            expectLayer(image, kSurfaceVplLayerName);
+            EXPECT_LT(std::get<double>(image.metadata.at("vrl.surfaceVplPaths")),
+                      std::get<double>(image.metadata.at("vrl.lightPaths")));
+        }
+    }
+}
+
 // A time-limited job leases (tile, pass): with --spp 6 as its cap it runs 3
 // passes whatever the clock, and its image equals the embedded fixed render of
 // 6 samples bit for bit, every (tile, pass) taken exactly once, even when a

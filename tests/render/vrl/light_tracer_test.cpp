@@ -52,6 +52,47 @@ TEST(LightTracer, TargetCountKeepsWholeBatchesAndReportsMemory) {
     EXPECT_THROW(traceVrls(*scene, settings), std::invalid_argument);
 }
 
+// The surface VPL limit keeps the VPLs of the first whole chunks of paths: the
+// same VPLs as without a limit, in the same order, up to the first chunk that would
+// pass it, each with its flux divided by the paths that deposited (so flux x paths
+// agrees with the unlimited run's, up to float rounding of the two divisions), on
+// any thread count; the VRLs do not change. The first chunk is kept whatever the
+// limit (a part (b) from 64 paths rather than none).
+TEST(LightTracer, SurfaceVplLimitKeepsTheFirstPathsVplsAndRenormalises) {
+    const auto scene = Scene::build(test::litRoomWithOccluder(Rgb(0.4f), Rgb(0.1f), 0.0f));
+    LightTracingSettings settings;
+    settings.targetVrls = 20000;
+    settings.seed = 3;
+    settings.surfaceVpls = true;
+    const VrlSet all = traceVrls(*scene, settings);
+    ASSERT_GT(all.surfaceVpls.size(), 3000u);
+    EXPECT_EQ(all.surfaceVplPaths, all.lightPaths);
+    settings.surfaceVplLimit = 3000;
+    const VrlSet a = traceWithThreads(*scene, settings, 1), b = traceWithThreads(*scene, settings, 2);
+    ASSERT_EQ(a.surfaceVpls.size(), b.surfaceVpls.size());
+    EXPECT_EQ(std::memcmp(a.surfaceVpls.data(), b.surfaceVpls.data(), a.surfaceVpls.size() * sizeof(SurfaceVpl)), 0);
+    EXPECT_EQ(a.surfaceVplPaths, b.surfaceVplPaths);
+    EXPECT_LE(a.surfaceVpls.size(), 3000u);
+    EXPECT_GT(a.surfaceVpls.size(), 2000u) << "a chunk of 64 paths should not leave this much of the limit unused";
+    EXPECT_EQ(a.surfaceVplPaths % 64, 0u) << "whole chunks of 64 paths";
+    EXPECT_LT(a.surfaceVplPaths, a.lightPaths);
+    ASSERT_EQ(a.vrls.size(), all.vrls.size());
+    EXPECT_EQ(std::memcmp(a.vrls.data(), all.vrls.data(), a.vrls.size() * sizeof(Vrl)), 0);
+    const double ratio = double(all.lightPaths) / double(a.surfaceVplPaths);
+    for (size_t i = 0; i < a.surfaceVpls.size(); ++i) {
+        const SurfaceVpl &limited = a.surfaceVpls[i], &full = all.surfaceVpls[i];
+        ASSERT_EQ(limited.position, full.position) << i;
+        ASSERT_EQ(limited.shape, full.shape) << i;
+        for (int c = 0; c < 3; ++c)
+            ASSERT_NEAR(double(limited.flux[c]), double(full.flux[c]) * ratio, 1e-5 * double(full.flux[c]) * ratio) << i;
+    }
+    settings.surfaceVplLimit = 1;  // below one chunk's: that chunk's all the same
+    const VrlSet one = traceVrls(*scene, settings);
+    EXPECT_EQ(one.surfaceVplPaths, 64u);
+    ASSERT_GT(one.surfaceVpls.size(), 1u);
+    EXPECT_EQ(one.surfaceVpls[1].position, all.surfaceVpls[1].position);
+}
+
 TEST(LightTracer, VrlsLieInsideTheirMediumWithPositiveLength) {
     const auto scene = Scene::build(test::mediumOnlyCube(Rgb(0.8f), Rgb(0.2f), 0.0f));
     LightTracingSettings settings;
