@@ -20,6 +20,7 @@
 #include "render/vrl/surface_vpl_estimator.h"
 
 #include "render/scene/scene.h"
+#include "tests/support/single_light_setting.h"
 #include "tests/support/statistics.h"
 #include "tests/support/test_scenes.h"
 
@@ -34,32 +35,16 @@ namespace {
 
 using V3d = Imath::V3d;
 using test::gaussLegendre;
-constexpr double kPiD = 3.14159265358979323846;
+constexpr double kPiD = test::kPiDouble;
 constexpr double kSigmas = 3.5;
 constexpr int kSamples = 200'000;
 const Rgb kRho(0.7f, 0.5f, 0.3f);
 
-V3d toD(const Vec3& v) { return {v.x, v.y, v.z}; }
+constexpr auto toD = &test::toDouble;
+constexpr auto hg = &test::henyeyGreenstein;
+using Medium = test::MediumCoefficients;
 
-double hg(double g, double cosine) {
-    const double denom = 1 + g * g - 2 * g * cosine;
-    return (1 - g * g) / (4 * kPiD * denom * std::sqrt(denom));
-}
-
-struct Medium {
-    Rgb sigmaS, sigmaA;
-    float g;
-};
-
-std::unique_ptr<Scene> planeInMedium(const Medium& m) {
-    SceneDescription d = test::pointLightInInfiniteMedium(Rgb(1.0f), Vec3(0.0f, 0.0f, 5.0f), m.sigmaS, m.sigmaA, m.g);
-    ShapeDescription plane;
-    plane.kind = ShapeDescription::Kind::Rectangle;  // [-1,1]^2 at z = 0, facing +z
-    plane.toWorld = Transform::scale(Vec3(100.0f));
-    plane.bsdf = test::diffuseBsdf(kRho, false);
-    d.shapes.push_back(plane);
-    return Scene::build(d);
-}
+std::unique_ptr<Scene> planeInMedium(const Medium& m) { return test::planeInMedium(m, kRho); }
 
 // A VPL where the light path from `from` towards `target` meets the plane.
 SurfaceVpl vplFrom(const Scene& scene, const Vec3& from, const Vec3& target, const Rgb& flux = Rgb(1.0f, 0.8f, 0.6f)) {
@@ -108,21 +93,10 @@ V3d reference(const SurfaceVpl& vpl, const CameraSegment& s, const Medium& m, co
 
 void expectUnbiased(const SurfaceVplEstimator& estimator, const SurfaceVpl& vpl, const CameraSegment& s,
                     const V3d& ref, uint64_t seed, const std::string& what) {
-    Rng rng(seed, 0);
-    V3d sum(0.0), sumSq(0.0);
-    for (int i = 0; i < kSamples; ++i) {
-        const Rgb c = estimator.contribution(vpl, s, rng);
-        ASSERT_TRUE(isFinite(c) && minComponent(c) >= 0.0f) << what;
-        sum += toD(c);
-        sumSq += toD(c) * toD(c);
-    }
-    double se[3], mean[3];
-    for (int c = 0; c < 3; ++c) {
-        mean[c] = sum[c] / kSamples;
-        se[c] = std::sqrt(std::max(0.0, sumSq[c] / kSamples - mean[c] * mean[c]) / (kSamples - 1));
-        EXPECT_NEAR(mean[c], ref[c], kSigmas * se[c] + 1e-4 * std::abs(ref[c]))
-            << what << " channel " << c << " SE " << se[c];
-    }
+    const test::SampleMean m = test::sampleMean(
+        seed, kSamples, [&](Rng& rng) { return estimator.contribution(vpl, s, rng); }, what);
+    test::expectMeanNear(m, ref, kSigmas, what);
+    const V3d mean = m.mean, se = m.standardError;
     // On the segment's line T_m T_r and the angles are constant: zero variance, the
     // mean is exact up to float rounding (the 1e-4 relative slack).
     std::printf("%-14s mean (%.6g %.6g %.6g) +- (%.2g %.2g %.2g), quadrature (%.6g %.6g %.6g), "

@@ -13,6 +13,7 @@
 #include "render/vrl/vrl_estimator.h"
 
 #include "render/scene/scene.h"
+#include "tests/support/single_light_setting.h"
 #include "tests/support/statistics.h"
 #include "tests/support/test_scenes.h"
 
@@ -149,15 +150,7 @@ std::unique_ptr<Scene> infiniteMedium(const Rgb& sigmaS, const Rgb& sigmaA, floa
     return Scene::build(test::pointLightInInfiniteMedium(Rgb(1.0f), Vec3(0.0f), sigmaS, sigmaA, g));
 }
 
-Vrl makeVrl(const Vec3& origin, const Vec3& direction, float length, const Rgb& flux) {
-    Vrl v;
-    v.origin = origin;
-    v.direction = direction.normalized();
-    v.length = length;
-    v.flux = flux;
-    v.medium = 0;
-    return v;
-}
+using test::makeVrl;
 
 CameraSegment makeSegment(const Vec3& origin, const Vec3& direction, float length, const Rgb& before) {
     return {origin, direction.normalized(), length, 0, before};

@@ -13,6 +13,7 @@
 #include "render/vrl/vrl_surface_estimator.h"
 
 #include "render/scene/scene.h"
+#include "tests/support/single_light_setting.h"
 #include "tests/support/statistics.h"
 #include "tests/support/test_scenes.h"
 
@@ -26,33 +27,16 @@ namespace {
 
 using V3d = Imath::V3d;
 using test::gaussLegendre;
-constexpr double kPiD = 3.14159265358979323846;
+constexpr double kPiD = test::kPiDouble;
 constexpr double kSigmas = 3.5;
 constexpr int kSamples = 200'000;
 const Rgb kRho(0.7f, 0.5f, 0.3f);
 
-V3d toD(const Vec3& v) { return {v.x, v.y, v.z}; }
+constexpr auto toD = &test::toDouble;
+constexpr auto hg = &test::henyeyGreenstein;
+using Medium = test::MediumCoefficients;
 
-double hg(double g, double cosine) {
-    const double denom = 1 + g * g - 2 * g * cosine;
-    return (1 - g * g) / (4 * kPiD * denom * std::sqrt(denom));
-}
-
-
-struct Medium {
-    Rgb sigmaS, sigmaA;
-    float g;
-};
-
-std::unique_ptr<Scene> planeInMedium(const Medium& m) {
-    SceneDescription d = test::pointLightInInfiniteMedium(Rgb(1.0f), Vec3(0.0f, 0.0f, 5.0f), m.sigmaS, m.sigmaA, m.g);
-    ShapeDescription plane;
-    plane.kind = ShapeDescription::Kind::Rectangle;  // [-1,1]^2 at z = 0, facing +z
-    plane.toWorld = Transform::scale(Vec3(100.0f));
-    plane.bsdf = test::diffuseBsdf(kRho, false);
-    d.shapes.push_back(plane);
-    return Scene::build(d);
-}
+std::unique_ptr<Scene> planeInMedium(const Medium& m) { return test::planeInMedium(m, kRho); }
 
 // The surface point straight below `above`, seen from `eye`.
 CameraPathSurface surfacePoint(const Scene& scene, const Vec3& onPlane, const Vec3& eye, const Rgb& throughput) {
@@ -96,31 +80,13 @@ V3d reference(const Vrl& vrl, const CameraPathSurface& x, const Medium& m, const
 
 void expectUnbiased(const VrlSurfaceEstimator& estimator, const Vrl& vrl, const CameraPathSurface& x, const V3d& ref,
                     uint64_t seed, const std::string& what) {
-    Rng rng(seed, 0);
-    V3d sum(0.0), sumSq(0.0);
-    for (int i = 0; i < kSamples; ++i) {
-        const Rgb c = estimator.contribution(vrl, x, rng);
-        ASSERT_TRUE(isFinite(c) && minComponent(c) >= 0.0f) << what;
-        sum += toD(c);
-        sumSq += toD(c) * toD(c);
-    }
-    for (int c = 0; c < 3; ++c) {
-        const double mean = sum[c] / kSamples;
-        const double se = std::sqrt(std::max(0.0, sumSq[c] / kSamples - mean * mean) / (kSamples - 1));
-        EXPECT_NEAR(mean, ref[c], kSigmas * se + 1e-4 * std::abs(ref[c])) << what << " channel " << c << " SE " << se;
-    }
+    const test::SampleMean m = test::sampleMean(
+        seed, kSamples, [&](Rng& rng) { return estimator.contribution(vrl, x, rng); }, what);
+    test::expectMeanNear(m, ref, kSigmas, what);
     ASSERT_GT(ref[1], 0.0) << what << ": the configuration must receive light";
 }
 
-Vrl makeVrl(const Vec3& origin, const Vec3& direction, float length, const Rgb& flux = Rgb(1.0f, 0.8f, 0.6f)) {
-    Vrl v;
-    v.origin = origin;
-    v.direction = direction.normalized();
-    v.length = length;
-    v.flux = flux;
-    v.medium = 0;
-    return v;
-}
+using test::makeVrl;
 
 const Medium kGrey{Rgb(0.8f), Rgb(0.2f), 0.0f};
 const Medium kChromatic{Rgb(0.4f, 0.8f, 1.4f), Rgb(0.2f, 0.1f, 0.05f), 0.0f};
