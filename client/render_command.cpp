@@ -231,6 +231,9 @@ int runRender(const RenderCommandOptions& o, const CLI::App& command) {
             std::fprintf(stderr, "  %d independent VRL sets (counts above are over all of them); sample s uses set s mod %d\n",
                          settings.vrlSets, settings.vrlSets);
         std::fprintf(stderr, "  transport parts: %s\n", settings.transports.toString().c_str());
+        if (settings.shadingPointsPerSide > 1 && settings.method != RenderMethod::VrlStochastic)
+            std::fprintf(stderr, "  (c), (d) and (b)'s surface VPLs at %dx%d shading points per pixel\n",
+                         settings.shadingPointsPerSide, settings.shadingPointsPerSide);
         if (usesSurfaceVpls(settings) && stats.surfaceVplPaths < stats.lightPaths)
             std::fprintf(stderr, "  (b) surface light from %llu surface VPLs of the first %llu of the same light paths "
                          "(limit %llu)\n", (unsigned long long)stats.surfaceVplCount,

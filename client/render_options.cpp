@@ -126,6 +126,11 @@ void addRenderOptions(CLI::App& cmd, RenderCommandOptions& o) {
                    "(by a cut for vpl-lightcuts); their cost grows with it, the noise of the distance sampling "
                    "falls (default " + std::to_string(kDefaultVplDistanceSamples) + ")")
         ->check(CLI::Range(1u, uint32_t(kMaxVplDistanceSamples)));
+    cmd.add_option("--shading-points", o.shadingPoints,
+                   "vrl, vrl-lightcuts, vpl, vpl-lightcuts: shade parts (c), (d) and (b)'s surface VPLs, which these "
+                   "methods evaluate once per pixel, at K x K stratified points of the pixel and average them: their "
+                   "noise between seeds at edges and on textures falls, their cost grows K^2 (default 1)")
+        ->check(CLI::Range(1u, uint32_t(kMaxShadingPointsPerSide)));
     cmd.add_option("--surface-vpls", o.surfaceVpls,
                    "vrl, vrl-lightcuts: the most surface VPLs for part (b)'s surface light, deposited by the first "
                    "light paths until the limit (fewer paths: a noisier, not a darker, part (b)); 0: none, part (b) "
@@ -160,6 +165,8 @@ void warnIneffectiveFlags(const CLI::App& command, RenderMethod method, bool dis
         {"--cut-size", method == RenderMethod::VrlStochastic, "vrl-stochastic"},
         {"--exact-distance-below", method == RenderMethod::VrlLightcuts, "vrl-lightcuts"},
         {"--distance-samples", usesVpls(method), "vpl and vpl-lightcuts"},
+        {"--shading-points", virtualLights && method != RenderMethod::VrlStochastic,
+         "vrl, vrl-lightcuts, vpl and vpl-lightcuts (vrl-stochastic shades every sample)"},
         {"--surface-vpls", method == RenderMethod::Vrl || method == RenderMethod::VrlLightcuts, "vrl and vrl-lightcuts"},
     };
     const std::string name(methodName(method));
@@ -251,6 +258,7 @@ v1::RenderParameters toRenderParameters(const RenderCommandOptions& o) {
     p.set_cut_size(o.cutSize);
     p.set_vrl_sets(o.vrlSets);
     p.set_vpl_distance_samples(o.distanceSamples);
+    p.set_shading_points(o.shadingPoints);
     // The spec's -1 is none, its 0 the default.
     if (o.surfaceVpls) p.set_surface_vpls(*o.surfaceVpls == 0 ? -1 : int64_t(*o.surfaceVpls));
     return p;

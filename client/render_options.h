@@ -44,6 +44,7 @@ struct RenderCommandOptions {
     uint32_t cutSize = 32;  // vrl-stochastic
     uint32_t vrlSets = 1;   // vrl-stochastic
     uint32_t distanceSamples = kDefaultVplDistanceSamples;  // vpl, vpl-lightcuts: per camera segment
+    uint32_t shadingPoints = 1;  // vrl, vrl-lightcuts, vpl, vpl-lightcuts: K x K points per pixel for (c), (d)
     std::optional<uint64_t> surfaceVpls;  // vrl, vrl-lightcuts: the most surface VPLs; 0: none; empty: the default
     // Distributed rendering (render --workers, submit)
     int workers = 0;       // render: 0 embedded, N: a local coordinator and N worker processes

@@ -41,6 +41,8 @@ void writeRenderMetadata(const RenderRecord& record, const PerspectiveCamera& ca
         metadata[usesVpls(s.method) ? "vrl.vpls" : "vrl.vrls"] = double(stats.vrlCount);
         metadata["vrl.lightPaths"] = double(stats.lightPaths);
         metadata["vrl.time.lightTracing"] = stats.tracingSeconds;
+        if (s.method != RenderMethod::VrlStochastic && s.shadingPointsPerSide > 1)
+            metadata["vrl.shadingPoints"] = int32_t(s.shadingPointsPerSide);  // per side: K x K points
         if (usesSurfaceVpls(s)) {
             metadata["vrl.surfaceVpls"] = double(stats.surfaceVplCount);
             metadata["vrl.surfaceVplLimit"] = double(surfaceVplLimit(s));

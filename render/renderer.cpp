@@ -41,6 +41,16 @@ Ray cameraRay(const PerspectiveCamera& camera, const RenderSettings& settings, i
     return camera.generateRay(float(x + camera.cropX0()) + jx, float(y + camera.cropY0()) + jy);
 }
 
+// Point (sx, sy) of a side x side grid over the pixel: jittered within its stratum, or its centre.
+Ray stratifiedCameraRay(const PerspectiveCamera& camera, const RenderSettings& settings, int x, int y, int sx, int sy,
+                        int side, Rng& rng) {
+    const float jx = settings.jitter ? rng.next() : 0.5f;
+    const float jy = settings.jitter ? rng.next() : 0.5f;
+    const float inverse = 1.0f / float(side);
+    return camera.generateRay(float(x + camera.cropX0()) + (float(sx) + jx) * inverse,
+                              float(y + camera.cropY0()) + (float(sy) + jy) * inverse);
+}
+
 bool isVrlMethod(const RenderSettings& settings) { return usesVirtualLights(settings.method); }
 
 // Part (c) comes from the VRLs (the VPL methods path-trace it).
@@ -114,6 +124,10 @@ void validateRenderSettings(const RenderSettings& settings) {
                                     ") need the vrl-stochastic method, which draws its VRLs per camera sample; " +
                                     std::string(methodName(settings.method)) +
                                     " shades a whole set per pixel (ask for more --vrls instead)");
+    if (settings.shadingPointsPerSide < 1 || settings.shadingPointsPerSide > kMaxShadingPointsPerSide)
+        throw std::invalid_argument("the shading points per pixel side must be in [1, " +
+                                    std::to_string(kMaxShadingPointsPerSide) + "], not " +
+                                    std::to_string(settings.shadingPointsPerSide));
     if (!(settings.timeLimitSeconds >= 0.0 && settings.timeLimitSeconds <= kMaxTimeLimitSeconds))
         throw std::invalid_argument("the time limit must be 0 (none) or a number of seconds up to " +
                                     std::to_string(int64_t(kMaxTimeLimitSeconds)) + ", got " +
@@ -436,11 +450,27 @@ TileSums TileShader::shadeTile(const TileRect& tile, int firstPass, int passCoun
                 if (p != 0 || !integrator_ || lightsPerSample_) continue;
                 // (c) and (d) once per pixel, in pass 0, from the pixel's own stream: their cost is per
                 // VRL, not per camera sample. (c)'s cut measures its error against sample 0's other parts.
-                Rng rng(settings_.seed, Rng::combine(pixel, kPixelLightsSample));
-                const Ray ray = cameraRay(camera, settings_, x, y, rng);
+                // With K x K shading points, point m has its own stream and stratum; their mean is the
+                // pixel's value and the counters their sum.
+                const int side = settings_.shadingPointsPerSide, points = side * side;
                 CutStatistics cut, surfaceCut, surfaceVplCut;
-                const auto lit =
-                    integrator_->virtualLightParts(ray, rng, &cut, &surfaceCut, firstSampleLuminance, &surfaceVplCut);
+                TransportIntegrator::VirtualLightParts lit;
+                for (int m = 0; m < points; ++m) {
+                    Rng rng(settings_.seed, Rng::combine(pixel, kPixelLightsSample - uint64_t(m)));
+                    const Ray ray = side == 1 ? cameraRay(camera, settings_, x, y, rng)
+                                              : stratifiedCameraRay(camera, settings_, x, y, m % side, m / side, side, rng);
+                    const auto one =
+                        integrator_->virtualLightParts(ray, rng, &cut, &surfaceCut, firstSampleLuminance, &surfaceVplCut);
+                    if (m == 0) {
+                        lit = one;
+                        continue;
+                    }
+                    lit.mediumSurface += one.mediumSurface, lit.multiple += one.multiple, lit.singleSurface += one.singleSurface;
+                }
+                if (points > 1) {
+                    const float inverse = 1.0f / float(points);
+                    lit.mediumSurface *= inverse, lit.multiple *= inverse, lit.singleSurface *= inverse;
+                }
                 size_t layer = 1;
                 for (size_t part = 0; part < 4; ++part) {
                     if (!settings_.transports.enabled[part]) continue;

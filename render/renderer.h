@@ -86,6 +86,9 @@ inline constexpr int kMaxVplDistanceSamples = 4096;
 // light path with lightPaths), what estimateLightMemoryBytes counts.
 inline constexpr uint64_t kAutoSurfaceVpls = ~uint64_t(0);
 
+// The most shading points per pixel side (RenderSettings::shadingPointsPerSide).
+inline constexpr int kMaxShadingPointsPerSide = 16;
+
 // The longest time limit a render takes (about 116 days): a guard against typos such as 1e30.
 inline constexpr double kMaxTimeLimitSeconds = 1e7;
 
@@ -119,6 +122,12 @@ struct RenderSettings {
     // fewer paths make (b) noisier, not darker). 0: none, part (b) path-samples its
     // surface light as vrl-stochastic does. kAutoSurfaceVpls: see there.
     uint64_t surfaceVplLimit = kAutoSurfaceVpls;
+    // Methods that shade (c), (d) and (b)'s surface VPLs once per pixel (vrl, vrl-lightcuts,
+    // vpl, vpl-lightcuts): at K x K points of the pixel (K this), each in its stratum
+    // (jittered, or its centre without jitter) from its own stream, averaged. One point
+    // leaves those parts' noise between seeds mostly the pixel's footprint (edges,
+    // textures); K x K points cost K^2 times those parts.
+    int shadingPointsPerSide = 1;
 };
 
 struct RenderStatistics {
@@ -217,7 +226,8 @@ std::vector<std::string> renderLayerNames(const RenderSettings& settings);
 
 // Sample s of pixel (x, y) of a tile draws from the stream
 // (seed, Rng::combine(camera.filmPixelIndex(x, y), s)) only.
-inline constexpr uint64_t kPixelLightsSample = ~uint64_t(0);  // the sample index of the once-per-pixel stream
+// The once-per-pixel parts' stream: sample index kPixelLightsSample - m for shading point m.
+inline constexpr uint64_t kPixelLightsSample = ~uint64_t(0);
 
 // A tile's sample sums (sample_sums.h) and how far it got.
 struct TileSums {

@@ -81,6 +81,7 @@ v1::RenderParameters defaultRenderParameters(RenderMethod method) {
     p.set_vrl_sets(uint32_t(d.vrlSets));
     p.set_vpl_distance_samples(uint32_t(d.vplDistanceSamples));
     p.set_surface_vpls(0);  // d.surfaceVplLimit: kAutoSurfaceVpls
+    p.set_shading_points(uint32_t(d.shadingPointsPerSide));
     return p;
 }
 
@@ -140,6 +141,9 @@ void validateJobSpec(const v1::JobSpec& spec, const ServiceLimits& limits) {
     if (p.surface_vpls() < -1 || (p.surface_vpls() > 0 && uint64_t(p.surface_vpls()) > limits.maxVrls))
         throw JobSpecError("the surface VPLs must be -1 (none), 0 (the default) or 1..." + std::to_string(limits.maxVrls) +
                            " (this coordinator's light limit), got " + std::to_string(p.surface_vpls()));
+    if (p.shading_points() > uint32_t(kMaxShadingPointsPerSide))
+        throw JobSpecError("the shading points per pixel side must be in 1..." + std::to_string(kMaxShadingPointsPerSide) +
+                           " (0: one), got " + std::to_string(p.shading_points()));
     if (p.exact_distance_below() > (1u << 20))
         throw JobSpecError("exact distance below must be in 0..." + std::to_string(1u << 20) + ", got " +
                            std::to_string(p.exact_distance_below()));
@@ -232,6 +236,7 @@ ResolvedJob resolveJob(const std::filesystem::path& sceneFile, const v1::JobSpec
     if (p.cut_size() > 0) s.cut.stochasticCutSize = p.cut_size();
     s.vrlSets = p.vrl_sets() > 0 ? int(p.vrl_sets()) : 1;
     if (p.vpl_distance_samples() > 0) s.vplDistanceSamples = int(p.vpl_distance_samples());
+    if (p.shading_points() > 0) s.shadingPointsPerSide = int(p.shading_points());
     s.surfaceVplLimit = p.surface_vpls() == 0 ? kAutoSurfaceVpls : p.surface_vpls() < 0 ? 0 : uint64_t(p.surface_vpls());
     try {
         validateRenderSettings(s);

@@ -9,7 +9,10 @@
 #include <gtest/gtest.h>
 #include <tbb/task_arena.h>
 
+#include <cmath>
 #include <optional>
+#include <stdexcept>
+#include <string>
 
 namespace vrl {
 namespace {
@@ -125,6 +128,63 @@ TEST(RendererDeterminism, JitteredImagesIgnoreThreadsAndTileSize) {
 
 // A crop window (hdrfilm cropOffsetX..., --crop) renders the window of the full
 // film bit for bit: every layer, with jitter on and off, for path and vrl-lightcuts.
+const Image& layer(const ImageSet& set, const std::string& name) {
+    for (const auto& [n, image] : set.layers)
+        if (n == name) return image;
+    throw std::runtime_error("no layer " + name);
+}
+
+// K x K shading points: the once-per-pixel parts (c), (d) and (b)'s surface VPLs
+// become the mean of K^2 stratified points, each uniform over the pixel, so their
+// expectation does not change. With the same seed the VRL set is the same, and the
+// per-pixel differences against one point are independent with mean zero: their
+// image mean lies within 4 standard errors of 0 (a two-sided z-test, p = 6e-5 of
+// a false failure; seed fixed). Rays all in one corner, or points left out of the
+// mean, move it by far more. The path-sampled parts (a), (b) do not change at all,
+// nor do threads change a bit; the counters are summed over the points (about
+// K^2 times as many evaluations).
+TEST(Renderer, ShadingPointsKeepTheMeanOfTheOncePerPixelParts) {
+    const auto scene = Scene::build(test::litRoomWithOccluder(Rgb(0.4f), Rgb(0.1f), 0.0f));
+    RenderSettings settings;
+    settings.method = RenderMethod::VrlLightcuts;
+    settings.samplesPerPixel = 2;
+    settings.vrlCount = 4000;
+    settings.seed = 31;
+    settings.jitter = true;
+    RenderStatistics oneStats, fourStats;
+    const ImageSet one = render(*scene, settings, {}, &oneStats);
+    settings.shadingPointsPerSide = 2;
+    const ImageSet four = render(*scene, settings, {}, &fourStats);
+    EXPECT_TRUE(bitIdentical(four.image, renderWithThreads(*scene, settings, 1)));
+    EXPECT_TRUE(bitIdentical(layer(one, "surface"), layer(four, "surface")));
+    EXPECT_TRUE(bitIdentical(layer(one, "single"), layer(four, "single")));
+    RenderRecord record;
+    record.settings = settings;
+    Metadata withPoints, without;
+    writeRenderMetadata(record, scene->camera(), withPoints);
+    EXPECT_EQ(metadataText(withPoints.at("vrl.shadingPoints")), "2");
+    record.settings.shadingPointsPerSide = 1;
+    writeRenderMetadata(record, scene->camera(), without);
+    EXPECT_FALSE(without.contains("vrl.shadingPoints"));
+    EXPECT_GT(fourStats.meanEvaluated, 2.5 * oneStats.meanEvaluated);
+    for (const char* name : {"medium-surface", "multiple", "single-vpl"}) {
+        const Image &a = layer(one, name), &b = layer(four, name);
+        double sum = 0.0, sumSq = 0.0, level = 0.0;
+        const size_t n = a.pixels().size();
+        for (size_t i = 0; i < n; ++i) {
+            const double d = double(luminance(b.pixels()[i])) - double(luminance(a.pixels()[i]));
+            sum += d, sumSq += d * d, level += luminance(a.pixels()[i]);
+        }
+        const double mean = sum / double(n), se = std::sqrt((sumSq / double(n) - mean * mean) / double(n - 1));
+        EXPECT_GT(level, 0.0) << name << " is black: the test would mean nothing";
+        EXPECT_GT(se, 0.0) << name << ": the points did not move";
+        EXPECT_LT(std::abs(mean), 4.0 * se) << name << ": mean difference " << mean << ", SE " << se
+                                            << ", mean level " << level / double(n);
+    }
+    settings.shadingPointsPerSide = kMaxShadingPointsPerSide + 1;
+    EXPECT_THROW(render(*scene, settings), std::invalid_argument);
+}
+
 TEST(RendererCrop, CropEqualsTheWindowOfTheFullRender) {
     const SceneDescription description = test::smallSmokeRoom();  // 24 x 16
     SceneDescription cropped = description;

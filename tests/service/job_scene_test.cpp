@@ -212,6 +212,27 @@ TEST(ResolveJob, SurfaceVplLimitComesFromTheSpec) {
     }
 }
 
+// The shading points per pixel side travel in the spec (0: one) and are checked
+// against kMaxShadingPointsPerSide before any work.
+TEST(ResolveJob, ShadingPointsComeFromTheSpec) {
+    const test::TempDir dir("vrl-job-scene");
+    const auto scene = writeScene(dir, "");
+    v1::JobSpec spec = specWithMethod("vrl-lightcuts");
+    EXPECT_EQ(rpc::defaultRenderParameters(RenderMethod::VrlLightcuts).shading_points(), 1u);
+    spec.mutable_parameters()->set_shading_points(0);
+    EXPECT_EQ(rpc::resolveJob(scene, spec, {}).settings.shadingPointsPerSide, 1);
+    spec.mutable_parameters()->set_shading_points(3);
+    EXPECT_EQ(rpc::resolveJob(scene, spec, {}).settings.shadingPointsPerSide, 3);
+    spec.mutable_parameters()->set_shading_points(uint32_t(kMaxShadingPointsPerSide) + 1);
+    try {
+        rpc::validateJobSpec(spec, {});
+        ADD_FAILURE() << "shading points " << kMaxShadingPointsPerSide + 1 << " accepted";
+    } catch (const rpc::JobSpecError& e) {
+        EXPECT_NE(std::string(e.what()).find("shading points per pixel side must be in 1..."), std::string::npos)
+            << e.what();
+    }
+}
+
 TEST(ResolveJob, CropAppliesAfterTheResolution) {
     const test::TempDir dir("vrl-job-scene");
     const auto scene = writeScene(dir, "");
