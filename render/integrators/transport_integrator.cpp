@@ -134,7 +134,9 @@ TransportIntegrator::VirtualLightParts TransportIntegrator::virtualLightParts(co
     // the cut's approximation.
     const uint64_t pixelKey = (uint64_t(rng.nextUint()) << 32) | rng.nextUint();
     const CameraPath path = cameraPath(scene_, cameraRay, scene_.cameraMedium(), &rng, settings_.maxDepth);
-    // (d) first: (c)'s cut measures its error against the pixel's other parts.
+    // (d) first: (c)'s cut measures its error against the pixel's other parts. (d)'s own
+    // cuts measure theirs against their total and the path-sampled parts (Lightcuts'
+    // error relative to the pixel; the paper's media-only images have only (d)).
     uint64_t segmentIndex = 0;
     for (const CameraSegment& segment : path.segments) {
         if (!multiple) break;
@@ -150,7 +152,7 @@ TransportIntegrator::VirtualLightParts TransportIntegrator::virtualLightParts(co
             Rng segmentRng = vrlStream(streamKey, ~0u);
             parts.multiple += stochastic_->estimate(segment, segmentRng, statistics);
         } else if (lightcuts_) {
-            parts.multiple += lightcuts_->estimate(segment, streamKey, statistics);
+            parts.multiple += lightcuts_->estimate(segment, streamKey, statistics, pathLuminance);
         } else {
             parts.multiple += estimator_.sumOverVrls(*plainLanes_, segment, streamKey);
         }

@@ -76,9 +76,10 @@ public:
 
     // The virtual-light parts for one camera ray: (c) at the surface the camera
     // path reaches (VRL methods) and (d) along its medium segments, each from every
-    // light or a cut, with the cuts' counters. (c)'s cut measures its error against
-    // the whole pixel: its own total, (d)'s, and `pathLuminance`, the luminance of
-    // the path-sampled parts (a), (b) of the pixel (0: against (c) alone).
+    // light or a cut, with the cuts' counters. The cuts measure their error against
+    // the pixel: `pathLuminance` is the luminance of its path-sampled parts (a), (b)
+    // (0: against the cut's parts alone); (d)'s cut adds its own total, (c)'s its own
+    // and (d)'s, the surface VPLs' cut its own, (d)'s and (c)'s.
     // singleSurface: (b)'s light from surface VPLs (zero without them).
     struct VirtualLightParts {
         Rgb mediumSurface{0.0f}, multiple{0.0f}, singleSurface{0.0f};

@@ -71,7 +71,7 @@ struct CutScratch {
 };
 
 // `otherLuminance`: the luminance of what the pixel receives besides this cut
-// (0: the cut's own total is the reference, as in the paper's part (d)); the
+// (0: the cut's own total is the reference, as in the paper's media-only images); the
 // threshold then applies to the pixel's total, as Lightcuts' relative error
 // does (Walter et al. 2005: a fraction of the pixel's value).
 // A visitor may also offer

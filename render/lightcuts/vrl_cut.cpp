@@ -11,7 +11,8 @@ LightcutsEstimator::LightcutsEstimator(const Scene& scene, const LightTree& tree
                                        CutSettings settings, const DirectionCones* cones, const LeafSegments* leaves)
     : tree_(tree), estimator_(estimator), settings_(settings), bound_(scene, tree, settings.bound, cones, leaves) {}
 
-Rgb LightcutsEstimator::estimate(const CameraSegment& segment, uint64_t streamKey, CutStatistics& statistics) const {
+Rgb LightcutsEstimator::estimate(const CameraSegment& segment, uint64_t streamKey, CutStatistics& statistics,
+                                 float otherLuminance) const {
     if (tree_.empty() || !(segment.length > 0.0f)) return Rgb(0.0f);
     struct Visitor {
         const LightcutsEstimator& self;
@@ -48,7 +49,7 @@ Rgb LightcutsEstimator::estimate(const CameraSegment& segment, uint64_t streamKe
             }
         }
     };
-    return walkCut(tree_, settings_, statistics, Visitor{*this, segment, streamKey});
+    return walkCut(tree_, settings_, statistics, Visitor{*this, segment, streamKey}, otherLuminance);
 }
 
 }  // namespace vrl

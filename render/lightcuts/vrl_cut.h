@@ -27,7 +27,10 @@ public:
     // Multiple scattering from every VRL of the tree along `segment`. The sample of
     // VRL k comes from the stream (streamKey, k) (see vrlStream), as in plain VRL
     // shading, so a cluster's estimate is its representative's plain sample rescaled.
-    Rgb estimate(const CameraSegment& segment, uint64_t streamKey, CutStatistics& statistics) const;
+    // `otherLuminance`: what the pixel receives besides this segment's (d) (walkCut);
+    // 0, the cut's own total alone is the error's reference, as in the paper.
+    Rgb estimate(const CameraSegment& segment, uint64_t streamKey, CutStatistics& statistics,
+                 float otherLuminance = 0.0f) const;
 
 private:
     const LightTree& tree_;
