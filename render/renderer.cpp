@@ -34,14 +34,8 @@ constexpr const char* kSurfaceStochasticLayerNames[3] = {"medium-surface-eval", 
 // vrl-lightcuts: the cut over surface VPLs (part (b)'s surface light), per pixel, over its camera segments.
 constexpr const char* kSurfaceVplCutLayerNames[3] = {"single-vpl-eval", "single-vpl-inter", "single-vpl-cut"};
 
-// The ray of image pixel (x, y): through its film pixel, so a crop shades what the full film would.
-Ray cameraRay(const PerspectiveCamera& camera, const RenderSettings& settings, int x, int y, Rng& rng) {
-    const float jx = settings.jitter ? rng.next() : 0.5f;
-    const float jy = settings.jitter ? rng.next() : 0.5f;
-    return camera.generateRay(float(x + camera.cropX0()) + jx, float(y + camera.cropY0()) + jy);
-}
-
-// Point (sx, sy) of a side x side grid over the pixel: jittered within its stratum, or its centre.
+// Point (sx, sy) of a side x side grid over image pixel (x, y): jittered within its stratum,
+// or its centre; through the film pixel, so a crop shades what the full film would.
 Ray stratifiedCameraRay(const PerspectiveCamera& camera, const RenderSettings& settings, int x, int y, int sx, int sy,
                         int side, Rng& rng) {
     const float jx = settings.jitter ? rng.next() : 0.5f;
@@ -49,6 +43,11 @@ Ray stratifiedCameraRay(const PerspectiveCamera& camera, const RenderSettings& s
     const float inverse = 1.0f / float(side);
     return camera.generateRay(float(x + camera.cropX0()) + (float(sx) + jx) * inverse,
                               float(y + camera.cropY0()) + (float(sy) + jy) * inverse);
+}
+
+// The ray of image pixel (x, y): the grid of side 1 ((0 + j) x 1 = j, the same bits as j).
+Ray cameraRay(const PerspectiveCamera& camera, const RenderSettings& settings, int x, int y, Rng& rng) {
+    return stratifiedCameraRay(camera, settings, x, y, 0, 0, 1, rng);
 }
 
 bool isVrlMethod(const RenderSettings& settings) { return usesVirtualLights(settings.method); }
@@ -457,8 +456,7 @@ TileSums TileShader::shadeTile(const TileRect& tile, int firstPass, int passCoun
                 TransportIntegrator::VirtualLightParts lit;
                 for (int m = 0; m < points; ++m) {
                     Rng rng(settings_.seed, Rng::combine(pixel, kPixelLightsSample - uint64_t(m)));
-                    const Ray ray = side == 1 ? cameraRay(camera, settings_, x, y, rng)
-                                              : stratifiedCameraRay(camera, settings_, x, y, m % side, m / side, side, rng);
+                    const Ray ray = stratifiedCameraRay(camera, settings_, x, y, m % side, m / side, side, rng);
                     const auto one =
                         integrator_->virtualLightParts(ray, rng, &cut, &surfaceCut, firstSampleLuminance, &surfaceVplCut);
                     if (m == 0) {
