@@ -234,13 +234,20 @@ int runRender(const RenderCommandOptions& o, const CLI::App& command) {
         if (settings.shadingPointsPerSide > 1 && settings.method != RenderMethod::VrlStochastic)
             std::fprintf(stderr, "  (c), (d) and (b)'s surface VPLs at %dx%d shading points per pixel\n",
                          settings.shadingPointsPerSide, settings.shadingPointsPerSide);
+        const char* vplParts = surfaceVplsLightSingle(settings) && surfaceVplsLightSurfaces(settings) ? "(a), (b)"
+                               : surfaceVplsLightSurfaces(settings)                                 ? "(a)"
+                                                                                                    : "(b)";
         if (usesSurfaceVpls(settings) && stats.surfaceVplPaths < stats.lightPaths)
-            std::fprintf(stderr, "  (b) surface light from %llu surface VPLs of the first %llu of the same light paths "
-                         "(limit %llu)\n", (unsigned long long)stats.surfaceVplCount,
+            std::fprintf(stderr, "  %s surface light from %llu surface VPLs of the first %llu of the same light paths "
+                         "(limit %llu)\n", vplParts, (unsigned long long)stats.surfaceVplCount,
                          (unsigned long long)stats.surfaceVplPaths, (unsigned long long)surfaceVplLimit(settings));
         else if (usesSurfaceVpls(settings))
-            std::fprintf(stderr, "  (b) surface light from %llu surface VPLs of the same light paths\n",
+            std::fprintf(stderr, "  %s surface light from %llu surface VPLs of the same light paths\n", vplParts,
                          (unsigned long long)stats.surfaceVplCount);
+        if (surfaceVplsLightSurfaces(settings))
+            std::fprintf(stderr, "  (a) samples %u surface VPLs per camera sample, the inverse square clamped at %.4g "
+                         "scene units (path tracing adds the rest)\n", kSurfaceVplSamples,
+                         double(stats.surfaceVplRadius));
         else if (settings.surfaceVplLimit == 0 && settings.transports.has(TransportPart::Single))
             std::fprintf(stderr, "  (b) surface light path-sampled (--surface-vpls 0)\n");
     }
@@ -263,7 +270,7 @@ int runRender(const RenderCommandOptions& o, const CLI::App& command) {
         if (settings.transports.has(TransportPart::MediumSurface) && !usesVpls(settings.method))
             std::fprintf(stderr, "  per pixel, (c) medium-to-surface: #Eval %.1f, #Inter %.1f, cut size %.1f\n",
                          stats.surfaceMeanEvaluated, stats.surfaceMeanIntersected, stats.surfaceMeanCutSize);
-        if (usesSurfaceVpls(settings))
+        if (surfaceVplsLightSingle(settings))
             std::fprintf(stderr, "  per pixel, (b) surface VPLs: #Eval %.1f, #Inter %.1f, cut size %.1f\n",
                          stats.surfaceVplMeanEvaluated, stats.surfaceVplMeanIntersected, stats.surfaceVplMeanCutSize);
         std::fprintf(stderr, "  bound exceeded by %llu of %llu cluster estimates (%.4f%%)\n",

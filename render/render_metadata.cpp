@@ -47,6 +47,8 @@ void writeRenderMetadata(const RenderRecord& record, const PerspectiveCamera& ca
             metadata["vrl.surfaceVpls"] = double(stats.surfaceVplCount);
             metadata["vrl.surfaceVplLimit"] = double(surfaceVplLimit(s));
             metadata["vrl.surfaceVplPaths"] = double(stats.surfaceVplPaths);  // the light paths that deposited them
+            // Part (a)'s share: the inverse square clamped at this distance (scene units).
+            if (surfaceVplsLightSurfaces(s)) metadata["vrl.surfaceVplRadius"] = stats.surfaceVplRadius;
         } else if ((s.method == RenderMethod::Vrl || s.method == RenderMethod::VrlLightcuts) &&
                    s.transports.has(TransportPart::Single)) {
             metadata["vrl.surfaceVplLimit"] = 0.0;  // none: (b) path-samples its surface light
@@ -82,11 +84,12 @@ void writeRenderMetadata(const RenderRecord& record, const PerspectiveCamera& ca
                 metadata["vrl.surface.meanInter"] = stats.surfaceMeanIntersected;
             metadata["vrl.surface.meanCut"] = stats.surfaceMeanCutSize;
         }
-        if (usesSurfaceVpls(s)) {
+        if (surfaceVplsLightSingle(s)) {
             metadata["vrl.surfaceVpl.meanEval"] = stats.surfaceVplMeanEvaluated;
             metadata["vrl.surfaceVpl.meanInter"] = stats.surfaceVplMeanIntersected;
             metadata["vrl.surfaceVpl.meanCut"] = stats.surfaceVplMeanCutSize;
         }
+
         if (!stochastic) {
             metadata["vrl.boundExceeded"] = double(stats.boundExceeded);
             metadata["vrl.boundedEstimates"] = double(stats.boundedEstimates);

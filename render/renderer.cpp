@@ -68,8 +68,17 @@ bool needsLights(const RenderSettings& settings) { return needsVrls(settings) ||
 }  // namespace
 
 bool usesSurfaceVpls(const RenderSettings& settings) {
+    return surfaceVplsLightSingle(settings) || surfaceVplsLightSurfaces(settings);
+}
+
+bool surfaceVplsLightSingle(const RenderSettings& settings) {
     return (settings.method == RenderMethod::Vrl || settings.method == RenderMethod::VrlLightcuts) &&
            settings.transports.has(TransportPart::Single) && settings.surfaceVplLimit > 0;
+}
+
+bool surfaceVplsLightSurfaces(const RenderSettings& settings) {
+    return (settings.method == RenderMethod::Vrl || settings.method == RenderMethod::VrlLightcuts) &&
+           settings.transports.has(TransportPart::Surface) && settings.surfaceVplLimit > 0;
 }
 
 uint64_t surfaceVplLimit(const RenderSettings& settings) {
@@ -168,13 +177,16 @@ RenderLights prepareLights(const Scene& scene, const RenderSettings& settings, c
         stats.vrlBytes += set.memoryBytes();
         stats.tracingSeconds += set.tracingSeconds;
         if (tracing.surfaceVpls) {
-            // Plain and cut shading take the same list (prepareSurfaceVpls); the cut also its tree.
-            const bool cut = usesLightTree(settings.method);
+            // Plain and cut shading take the same list (prepareSurfaceVpls); the cut also its tree,
+            // and so does part (a)'s sampling of them (plain VRLs too: the methods then differ by
+            // their cuts alone).
+            const bool cut = usesLightTree(settings.method) || surfaceVplsLightSurfaces(settings);
             const auto treeStart = std::chrono::steady_clock::now();
             lights.surfaceVpls = prepareSurfaceVpls(scene, std::move(set.surfaceVpls), cut,
                                                     LightTreeSettings{settings.partitionSize, settings.seed});
             if (cut) stats.treeSeconds += secondsSince(treeStart);
             stats.surfaceVplCount = lights.surfaceVpls.vpls.size();
+            if (surfaceVplsLightSurfaces(settings)) stats.surfaceVplRadius = surfaceVplRadius(lights.surfaceVpls);
             stats.surfaceVplPaths = set.surfaceVplPaths;
             if (set.surfaceVplPaths < set.lightPaths)
                 spdlog::info("surface VPLs: the limit of {} was reached after {} of {} light paths; (b)'s surface "
@@ -236,7 +248,7 @@ uint64_t estimateLightMemoryBytes(const RenderSettings& settings) {
     double perSurfaceVpl = 0.0;
     if (usesSurfaceVpls(settings)) {
         perSurfaceVpl = 2.0 * sizeof(SurfaceVpl);
-        if (usesLightTree(settings.method))
+        if (usesLightTree(settings.method) || surfaceVplsLightSurfaces(settings))
             perSurfaceVpl += sizeof(Vrl) + 2.0 * sizeof(LightTreeNode) + double(LightTree::buildScratchBytesPerVrl());
     }
     const double bytes = perLight * double(settings.vrlCount) * double(std::max(1, settings.vrlSets)) +
@@ -259,14 +271,14 @@ std::vector<std::string> renderLayerNames(const RenderSettings& settings) {
     if (!isVrlMethod(settings)) return names;
     for (size_t p = 0; p < kTransportPartNames.size(); ++p)
         if (settings.transports.enabled[p]) names.emplace_back(kTransportPartNames[p]);
-    if (usesSurfaceVpls(settings)) names.emplace_back(kSurfaceVplLayerName);
+    if (surfaceVplsLightSingle(settings)) names.emplace_back(kSurfaceVplLayerName);
     if (usesLightTree(settings.method)) {
         const bool stochastic = settings.method == RenderMethod::VrlStochastic;
         for (const char* name : stochastic ? kStochasticLayerNames : kCutLayerNames) names.emplace_back(name);
         if (vrlLitSurfaces(settings))
             for (const char* name : stochastic ? kSurfaceStochasticLayerNames : kSurfaceCutLayerNames)
                 names.emplace_back(name);
-        if (usesSurfaceVpls(settings))
+        if (surfaceVplsLightSingle(settings))
             for (const char* name : kSurfaceVplCutLayerNames) names.emplace_back(name);
     }
     return names;
@@ -322,6 +334,7 @@ TileShader::TileShader(const Scene& scene, const RenderSettings& settings, const
         integratorSettings.vpls = usesVpls(settings.method);
         integratorSettings.vplDistanceSamples = settings.vplDistanceSamples;
         integratorSettings.stochastic = settings.method == RenderMethod::VrlStochastic;
+        integratorSettings.surfaceVplCut = lightcuts;
         integrator_ = std::make_unique<TransportIntegrator>(scene, lights.vrls, integratorSettings,
                                                       lightcuts && lights.tree.root() >= 0 ? &lights.tree : nullptr,
                                                       usesSurfaceVpls(settings) ? &lights.surfaceVpls : nullptr);

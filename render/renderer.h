@@ -150,6 +150,7 @@ struct RenderStatistics {
     uint64_t surfaceVplCount = 0;  // surface VPLs (part (b)), over the kept ones
     uint64_t surfaceVplPaths = 0;  // the light paths that deposited them (all unless the limit was reached)
     double surfaceVplMeanEvaluated = 0.0, surfaceVplMeanIntersected = 0.0, surfaceVplMeanCutSize = 0.0;  // their cut
+    float surfaceVplRadius = 0.0f;  // part (a)'s clamp radius R (0: (a) takes no light from them)
     uint64_t boundExceeded = 0, boundedEstimates = 0;  // inner-node estimates above their bound, (c) and (d)
 };
 
@@ -179,6 +180,10 @@ struct RenderLights {
 // Whether `settings` take part (b)'s surface light from surface VPLs: vrl and
 // vrl-lightcuts with part (b) selected and a surface VPL limit above 0.
 bool usesSurfaceVpls(const RenderSettings& settings);
+// They light part (b)'s medium-then-surface light / part (a)'s surface-to-surface
+// light (sampled per camera sample down their tree, transport_integrator.h).
+bool surfaceVplsLightSingle(const RenderSettings& settings);
+bool surfaceVplsLightSurfaces(const RenderSettings& settings);
 // settings.surfaceVplLimit with kAutoSurfaceVpls resolved.
 uint64_t surfaceVplLimit(const RenderSettings& settings);
 RenderLights prepareLights(const Scene& scene, const RenderSettings& settings, const ProgressCallback& progress = {},

@@ -2,9 +2,11 @@
 
 #include "render/core/sampling.h"
 #include "render/vrl/camera_segment.h"
+#include "render/vrl/surface_vpl_estimator.h"
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
 
 namespace vrl {
 
@@ -65,6 +67,8 @@ Rgb VolumetricPathTracer::radiance(Ray ray, int medium, Rng& rng, const PathStar
     using After = PathStart::AfterFirstSurface;
     After afterX1 = After::Any;
     bool pastX1 = false;
+    // start.surfaceVplRadius: x1's position while the path heads for x2 from x1's non-Dirac lobe.
+    std::optional<Vec3> x1ForVpls;
 
     float segmentStart = ray.tMin;  // where the ray entered its current medium
     int mediumBeforeCrossing = medium;  // before the last null boundary crossed
@@ -131,7 +135,16 @@ Rgb VolumetricPathTracer::radiance(Ray ray, int medium, Rng& rng, const PathStar
         const bool atX1 = !specularChain && !pastX1;
         if (!specularChain) firstSegment = false, pastX1 = true;
         const bool onlyInMediumNext = atX1 && start.afterFirstSurface == After::InMedium;
-        const bool onlyDiracNext = atX1 && start.diracAtFirstSurfaceOnly;
+        bool onlyDiracNext = atX1 && start.diracAtFirstSurfaceOnly;
+        // x2 of part (a) with surface VPLs: its non-Dirac reflection weighs 1 - (d/R)^2 (PathStart).
+        float nonDiracWeight = 1.0f;
+        if (x1ForVpls && !specularChain) {  // x2 (specularChain is false past x1)
+            const float d2 = (hit->position - *x1ForVpls).length2();
+            const float r2 = start.surfaceVplRadius * start.surfaceVplRadius;
+            nonDiracWeight = d2 < r2 ? 1.0f - d2 / r2 : 0.0f;
+            if (!(nonDiracWeight > 0.0f)) onlyDiracNext = true;
+            x1ForVpls.reset();
+        }
         if (Scene::withinCrossing(ray, *hit)) medium = mediumBeforeCrossing;
         if (restricted && vertices + 1 <= 2) break;  // a surface among the first two vertices
 
@@ -151,7 +164,7 @@ Rgb VolumetricPathTracer::radiance(Ray ray, int medium, Rng& rng, const PathStar
                         ? powerHeuristic(direct.pdf, bsdf.pdf(sp, wo, direct.direction) *
                                                          passProbability(direct.transmittance, passesSurely))
                         : 1.0f;
-                if (!isBlack(f)) result += throughput * direct.radianceOverPdf * f * weight;
+                if (!isBlack(f)) result += throughput * direct.radianceOverPdf * f * (weight * nonDiracWeight);
             }
         }
         const auto sampled = bsdf.sample(sp, wo, Vec2(rng.next(), rng.next()), rng.next(), TransportMode::Radiance);
@@ -160,6 +173,10 @@ Rgb VolumetricPathTracer::radiance(Ray ray, int medium, Rng& rng, const PathStar
         if (onlyInMediumNext && sampled->delta) break;
         if (onlyDiracNext && !sampled->delta) break;
         throughput *= sampled->weight;
+        if (!sampled->delta) throughput *= nonDiracWeight;
+        if (atX1 && !sampled->delta && start.surfaceVplRadius > 0.0f && afterX1 == After::NotInMedium &&
+            lambertianBounded(bsdf))
+            x1ForVpls = hit->position;
         const bool misEmission = settings_.surfaceMis && !sampled->delta;
         emissionCounts = (sampled->delta || misEmission) && (!restricted || vertices >= 2) && afterX1 != After::InMedium;
         bsdfPdf = misEmission ? sampled->pdf : 0.0f;

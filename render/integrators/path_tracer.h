@@ -69,6 +69,17 @@ struct PathStart {
     // firstSegmentTransmittanceOnly and emissionOnFirstHit, the complement of light
     // tracing connected to the camera (light_tracing_reference.h).
     bool diracAtFirstSurfaceOnly = false;
+    // Part (a) with surface VPLs (transport_integrator.h): R > 0 hands the light that
+    // x2 reflects by a non-Dirac lobe, where x2 is reached from x1 by a non-Dirac
+    // lobe and unscattered, x1's model Lambertian-bounded (lambertianBounded,
+    // surface_vpl_estimator.h), to the VPLs, except for the share the VPLs' clamped
+    // 1 / max(d, R)^2 leaves out: with d = |x2 - x1|, x2's non-Dirac reflection (its
+    // NEE and whatever follows a non-Dirac sample there) counts with weight
+    // 1 - (d / R)^2 where d < R, and not at all beyond. Emission at x2 and its Dirac
+    // lobes count in full. Since 1/d^2 = 1/max(d, R)^2 + (1/d^2 - 1/max(d, R)^2) and
+    // the second term is (1/d^2) max(0, 1 - d^2/R^2), the two estimators add up to
+    // the unsplit one. 0: off.
+    float surfaceVplRadius = 0.0f;
 };
 
 class VolumetricPathTracer {

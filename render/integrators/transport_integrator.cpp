@@ -16,8 +16,14 @@ TransportIntegrator::TransportIntegrator(const Scene& scene, const VrlSet& vrls,
       surfaceEstimator_(scene, settings.vrlSamples),
       tree_(tree),
       surfaceVplEstimator_(scene) {
-    if (surfaceVpls && settings.transports.has(TransportPart::Single) && !settings.vpls && !settings.stochastic) {
+    const bool forSingle = settings.transports.has(TransportPart::Single);
+    bool forSurface = surfaceVpls && !surfaceVpls->vpls.empty() && settings.transports.has(TransportPart::Surface);
+    if (surfaceVpls && (forSingle || forSurface) && !settings.vpls && !settings.stochastic) {
+        // (a) samples the VPLs down their tree: only with one.
+        forSurface = forSurface && !surfaceVpls->tree.empty();
         surfaceVpls_ = surfaceVpls;
+        surfaceVplsSingle_ = forSingle;
+        if (forSurface) surfaceVplRadius_ = ::vrl::surfaceVplRadius(*surfaceVpls);
         if (!surfaceVpls->tree.empty())
             surfaceVplLightcuts_ = std::make_unique<SurfaceVplLightcutsEstimator>(scene, *surfaceVpls,
                                                                                   surfaceVplEstimator_, settings.cut);
@@ -42,18 +48,22 @@ TransportIntegrator::TransportIntegrator(const Scene& scene, const VrlSet& vrls,
         plainLanes_ = std::make_unique<VrlLanes>(vrls.vrls, scene);
     }
     if (settings.maxDepth >= 0 && settings.maxDepth < 16 && scene.hasSpecularSurfaces() &&
-        (settings.transports.has(TransportPart::Multiple) ||
+        (settings.transports.has(TransportPart::Multiple) || surfaceVpls_ ||
          (!settings.vpls && settings.transports.has(TransportPart::MediumSurface))))
-        spdlog::warn("maxDepth {} with specular surfaces: the VRL parts (c), (d) (and (b)'s surface VPLs) seen "
-                     "through glass or mirrors do not count the specular bounces towards maxDepth", settings.maxDepth);
+        spdlog::warn("maxDepth {} with specular surfaces: the VRL parts (c), (d) (and the surface VPLs' light in (a), "
+                     "(b)) seen through glass or mirrors do not count the specular bounces towards maxDepth",
+                     settings.maxDepth);
 }
 
 std::array<Rgb, 4> TransportIntegrator::samplePathParts(const Ray& cameraRay, Rng& rng) const {
     std::array<Rgb, 4> parts{Rgb(0.0f), Rgb(0.0f), Rgb(0.0f), Rgb(0.0f)};
     using After = PathStart::AfterFirstSurface;
-    if (settings_.transports.has(TransportPart::Surface))
-        parts[size_t(TransportPart::Surface)] = tracer_.radiance(cameraRay, scene_.cameraMedium(), rng,
-                                                                 PathStart{0, true, true, true, After::NotInMedium});
+    if (settings_.transports.has(TransportPart::Surface)) {
+        PathStart start{0, true, true, true, After::NotInMedium};
+        start.surfaceVplRadius = surfaceVplRadius_;  // 0 without surface VPLs for (a)
+        parts[size_t(TransportPart::Surface)] = tracer_.radiance(cameraRay, scene_.cameraMedium(), rng, start);
+        if (surfaceVplRadius_ > 0.0f) parts[size_t(TransportPart::Surface)] += surfaceVplsAtSurface(cameraRay, rng);
+    }
     if (!vrlLitSurfaces() && settings_.transports.has(TransportPart::MediumSurface))
         parts[size_t(TransportPart::MediumSurface)] = tracer_.radiance(
             cameraRay, scene_.cameraMedium(), rng, PathStart{0, true, false, true, After::InMedium});
@@ -113,7 +123,7 @@ Rgb TransportIntegrator::mediumToSurface(const CameraSegment& segment, Rng& rng)
     // (b)'s single scattering. With surface VPLs, only what leaves that surface by a
     // Dirac lobe: the VPLs bring the rest (virtualLightParts).
     PathStart start{1 + segment.specularBefore, true, false};
-    start.diracAtFirstSurfaceOnly = surfaceVpls_ != nullptr;
+    start.diracAtFirstSurfaceOnly = surfaceVplsLight();
     const Rgb reflected = tracer_.radiance(Ray{x, next.direction}, segment.medium, rng, start);
     return segment.throughputBefore * medium.transmittance(float(u)) * medium.sigmaS() * reflected *
            float(1.0 / pdf);
@@ -127,7 +137,7 @@ TransportIntegrator::VirtualLightParts TransportIntegrator::virtualLightParts(co
     VirtualLightParts parts;
     const bool multiple = settings_.transports.has(TransportPart::Multiple);
     const bool surface = vrlLitSurfaces() && settings_.transports.has(TransportPart::MediumSurface);
-    if (!multiple && !surface && !surfaceVpls_) return parts;
+    if (!multiple && !surface && !surfaceVplsLight()) return parts;
     CutStatistics unused;
     // One stream family per camera segment (and one for the surface x1); VRL k draws
     // from (key, k) in both plain and Lightcuts shading, so the two differ only by
@@ -162,7 +172,7 @@ TransportIntegrator::VirtualLightParts TransportIntegrator::virtualLightParts(co
                                             surfaceStatistics ? *surfaceStatistics : unused,
                                             pathLuminance + std::max(0.0f, luminance(parts.multiple)));
     // (b)'s surface light from the VPLs, last: its cut measures its error against the pixel's other parts.
-    if (surfaceVpls_) {
+    if (surfaceVpls_ && surfaceVplsSingle_) {
         const float other = pathLuminance + std::max(0.0f, luminance(parts.multiple)) +
                             std::max(0.0f, luminance(parts.mediumSurface));
         CutStatistics& statistics = surfaceVplStatistics ? *surfaceVplStatistics : unused;
@@ -172,13 +182,26 @@ TransportIntegrator::VirtualLightParts TransportIntegrator::virtualLightParts(co
             const uint64_t streamKey = Rng::combine(pixelKey, segmentIndex++ | (uint64_t(1) << 63));
             if (scene_.media()[segment.medium].isNonScattering()) continue;
             if (settings_.maxDepth >= 0 && settings_.maxDepth < segment.specularBefore + 3) continue;
-            parts.singleSurface += surfaceVplLightcuts_
+            parts.singleSurface += surfaceVplLightcuts_ && settings_.surfaceVplCut
                                        ? surfaceVplLightcuts_->estimate(segment, streamKey, statistics,
                                                                         other + std::max(0.0f, luminance(parts.singleSurface)))
                                        : sumOverSurfaceVpls(surfaceVplEstimator_, surfaceVpls_->vpls, segment, streamKey);
         }
     }
     return parts;
+}
+
+Rgb TransportIntegrator::surfaceVplsAtSurface(const Ray& cameraRay, Rng& rng) const {
+    // The sample's own camera path to its x1 (its own specular choices: the path tracer's x1
+    // estimates the complement, each unbiased on its own).
+    const CameraPath path = cameraPath(scene_, cameraRay, scene_.cameraMedium(), &rng, settings_.maxDepth);
+    if (!path.surface) return Rgb(0.0f);
+    // A depth limit: the VPLs hold light paths of k + 2 <= maxDepth segments (light_tracer.h); the
+    // camera's specular bounces are not counted (the warning above), and where even x2's NEE is
+    // past the limit the path tracer has nothing to hand to them either.
+    if (settings_.maxDepth >= 0 && settings_.maxDepth < path.surface->specularBefore + 3) return Rgb(0.0f);
+    CutStatistics unused;
+    return surfaceVplLightcuts_->sample(*path.surface, surfaceVplRadius_, kSurfaceVplSamples, rng, unused);
 }
 
 Rgb TransportIntegrator::vrlLitSurface(const CameraPathSurface& x, uint64_t streamKey, CutStatistics& statistics,

@@ -7,7 +7,18 @@
 // camera_segment.h, past purely specular bounces):
 //   (a) x1 on a surface, x2 not in a medium: path-traced from x1, with the
 //       camera segment's exact transmittance and the segment after x1 crossed
-//       with its exact transmittance too (no medium vertex: (c) has those);
+//       with its exact transmittance too (no medium vertex: (c) has those).
+//       With surface VPLs (vrl, vrl-lightcuts), the light that x2 reflects by a
+//       non-Dirac lobe towards x1's non-Dirac lobes comes instead from the surface
+//       VPLs, with the inverse square clamped at distance R
+//       (surface_vpl_estimator.h): per camera sample, at that sample's x1, a
+//       stochastic cut of kSurfaceVplSamples VPLs drawn down their tree in
+//       proportion to their bound (surface_vpl_cut.h), unbiased. Per sample, not
+//       once per pixel: the sample's own x1 averages the pixel's footprint as the
+//       path tracer does (once per pixel, a pixel half on a lamp's bright inside
+//       came out either bright or dark). The path-traced part keeps x2's
+//       emission, its Dirac lobes and, for x2 within R of x1, the share the clamp
+//       leaves out (PathStart::surfaceVplRadius);
 //   (b) x1 in a medium, x2 not in a medium: single scattering from the lights
 //       (a point of the camera segment sampled equiangularly towards a light,
 //       next-event estimation there) plus light reflected by surfaces (a point
@@ -60,6 +71,9 @@ struct TransportIntegratorSettings {
     int vplDistanceSamples = kDefaultVplDistanceSamples;  // distance samples per camera segment (VPLs)
     // With a tree: (c), (d) by stochastic cuts (stochastic_vrl_cut.h) of cut.stochasticCutSize nodes.
     bool stochastic = false;
+    // (b)'s surface VPLs by a cut over their tree (vrl-lightcuts), else every VPL; part
+    // (a) samples them down that tree in both.
+    bool surfaceVplCut = false;
 };
 
 class TransportIntegrator {
@@ -89,7 +103,11 @@ public:
                                         CutStatistics* surfaceVplStatistics = nullptr) const;
 
     // Part (b)'s non-Dirac surface light comes from surface VPLs (virtualLightParts' singleSurface).
-    bool surfaceVplsLight() const { return surfaceVpls_ != nullptr; }
+    bool surfaceVplsLight() const { return surfaceVpls_ != nullptr && surfaceVplsSingle_; }
+    // Part (a)'s light from non-Dirac reflections at x2 comes from surface VPLs
+    // (samplePathParts), with the inverse square clamped at this radius.
+    bool surfaceVplsLightSurfaces() const { return surfaceVplRadius_ > 0.0f; }
+    float surfaceVplRadius() const { return surfaceVplRadius_; }
 
     // Part (c) is estimated from VRLs (not path-sampled).
     bool vrlLitSurfaces() const { return !settings_.vpls; }
@@ -103,6 +121,8 @@ public:
 private:
     Rgb singleScattering(const CameraSegment& segment, Rng& rng) const;
     Rgb mediumToSurface(const CameraSegment& segment, Rng& rng) const;
+    // Part (a)'s light from the surface VPLs at this camera sample's x1.
+    Rgb surfaceVplsAtSurface(const Ray& cameraRay, Rng& rng) const;
     Rgb vrlLitSurface(const CameraPathSurface& x, uint64_t streamKey, CutStatistics& statistics,
                       float otherLuminance) const;
 
@@ -121,7 +141,9 @@ private:
     std::unique_ptr<StochasticLightcutsEstimator> stochastic_;
     std::unique_ptr<VplLightcutsEstimator> vplLightcuts_;
     std::unique_ptr<VplEstimator> plainVpls_;
-    const SurfaceVplLights* surfaceVpls_ = nullptr;  // set only when part (b) takes its surface light from them
+    const SurfaceVplLights* surfaceVpls_ = nullptr;  // set only when part (a) or (b) takes light from them
+    bool surfaceVplsSingle_ = false;                 // part (b) does
+    float surfaceVplRadius_ = 0.0f;                  // > 0: part (a) does (surfaceVplRadius)
     SurfaceVplEstimator surfaceVplEstimator_;
     std::unique_ptr<SurfaceVplLightcutsEstimator> surfaceVplLightcuts_;
 };

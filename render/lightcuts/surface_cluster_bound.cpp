@@ -82,6 +82,48 @@ double SurfaceClusterBound::minimumDistance(int32_t index, const Vec3& x) const 
     return best;
 }
 
+Rgb SurfaceClusterBound::reflectionTowardsBox(const CameraPathSurface& x, const Bsdf& bsdf, const Imath::Box3f& box,
+                                              double d, double slack, float glossyMargin) {
+    const Vec3& p = x.hit.position;
+    // Reflection only on wo's geometric side: a box wholly behind gives nothing.
+    const bool reflectsOnly = bsdf.kind() != BsdfDescription::Kind::RoughDielectric;
+    const float side = x.wo.dot(x.hit.geometricNormal) >= 0.0f ? 1.0f : -1.0f;
+    if (reflectsOnly && signedDistanceRange(box, x.hit.geometricNormal * side, p).second < -slack) return Rgb(0.0f);
+
+    Rgb fCos;
+    const std::optional<Rgb> lambert = x.bsdf.lambertianBound();  // x's lookups: no texture read per node
+    if (lambert) {
+        const auto [lo, hi] = signedDistanceRange(box, x.hit.shadingNormal, p);
+        const double cosine = std::min(1.0, (std::max(std::abs(lo), std::abs(hi)) + slack) / d);
+        fCos = *lambert * float(cosine);
+    } else {
+        // Glossy: the largest f|cos| towards the box's corners, its centre and its
+        // point nearest the mirror direction (where a lobe peaks), with a margin (a heuristic).
+        const Vec3 n = x.hit.shadingNormal * (x.wo.dot(x.hit.shadingNormal) >= 0.0f ? 1.0f : -1.0f);
+        const Vec3 mirror = n * (2.0f * x.wo.dot(n)) - x.wo;
+        const float along = std::max(0.0f, mirror.dot(box.center() - p));
+        const Vec3 onMirror = p + mirror * along;
+        const Vec3 nearMirror(std::clamp(onMirror.x, box.min.x, box.max.x),
+                              std::clamp(onMirror.y, box.min.y, box.max.y),
+                              std::clamp(onMirror.z, box.min.z, box.max.z));
+        Rgb largest(0.0f);
+        for (int corner = 0; corner < 10; ++corner) {
+            const Vec3 q = corner == 9   ? nearMirror
+                           : corner == 8 ? box.center()
+                                         : Vec3(corner & 1 ? box.max.x : box.min.x,
+                                                corner & 2 ? box.max.y : box.min.y,
+                                                corner & 4 ? box.max.z : box.min.z);
+            const Vec3 to = q - p;
+            const float length = to.length();
+            if (!(length > 0.0f)) continue;
+            const Rgb f = x.bsdf.eval(to / length, TransportMode::Radiance);
+            for (int c = 0; c < 3; ++c) largest[c] = std::max(largest[c], f[c]);
+        }
+        fCos = largest * glossyMargin;
+    }
+    return fCos;
+}
+
 Rgb SurfaceClusterBound::bound(int32_t index, const CameraPathSurface& x, bool* xInsideNode) const {
     const LightTreeNode& node = tree_.nodes()[index];
     const Vec3& p = x.hit.position;
@@ -93,43 +135,8 @@ Rgb SurfaceClusterBound::bound(int32_t index, const CameraPathSurface& x, bool* 
     if (!(d > 0.0)) return Rgb(std::numeric_limits<float>::infinity());
 
     const SceneShape& shape = scene_.shapes()[x.hit.shape];
-    const Bsdf& bsdf = shape.bsdf;
-    // Reflection only on wo's geometric side: a box wholly behind gives nothing.
-    const bool reflectsOnly = bsdf.kind() != BsdfDescription::Kind::RoughDielectric;
-    const float side = x.wo.dot(x.hit.geometricNormal) >= 0.0f ? 1.0f : -1.0f;
-    if (reflectsOnly && signedDistanceRange(node.box, x.hit.geometricNormal * side, p).second < -slack) return Rgb(0.0f);
-
-    Rgb fCos;
-    const std::optional<Rgb> lambert = x.bsdf.lambertianBound();  // x's lookups: no texture read per node
-    if (lambert) {
-        const auto [lo, hi] = signedDistanceRange(node.box, x.hit.shadingNormal, p);
-        const double cosine = std::min(1.0, (std::max(std::abs(lo), std::abs(hi)) + slack) / d);
-        fCos = *lambert * float(cosine);
-    } else {
-        // Glossy: the largest f|cos| towards the box's corners, its centre and its
-        // point nearest the mirror direction (where a lobe peaks), with a margin (a heuristic).
-        const Vec3 n = x.hit.shadingNormal * (x.wo.dot(x.hit.shadingNormal) >= 0.0f ? 1.0f : -1.0f);
-        const Vec3 mirror = n * (2.0f * x.wo.dot(n)) - x.wo;
-        const float along = std::max(0.0f, mirror.dot(node.box.center() - p));
-        const Vec3 onMirror = p + mirror * along;
-        const Vec3 nearMirror(std::clamp(onMirror.x, node.box.min.x, node.box.max.x),
-                              std::clamp(onMirror.y, node.box.min.y, node.box.max.y),
-                              std::clamp(onMirror.z, node.box.min.z, node.box.max.z));
-        Rgb largest(0.0f);
-        for (int corner = 0; corner < 10; ++corner) {
-            const Vec3 q = corner == 9   ? nearMirror
-                           : corner == 8 ? node.box.center()
-                                         : Vec3(corner & 1 ? node.box.max.x : node.box.min.x,
-                                                corner & 2 ? node.box.max.y : node.box.min.y,
-                                                corner & 4 ? node.box.max.z : node.box.min.z);
-            const Vec3 to = q - p;
-            const float length = to.length();
-            if (!(length > 0.0f)) continue;
-            const Rgb f = x.bsdf.eval(to / length, TransportMode::Radiance);
-            for (int c = 0; c < 3; ++c) largest[c] = std::max(largest[c], f[c]);
-        }
-        fCos = largest * settings_.glossyMargin;
-    }
+    const bool reflectsOnly = shape.bsdf.kind() != BsdfDescription::Kind::RoughDielectric;
+    const Rgb fCos = reflectionTowardsBox(x, shape.bsdf, node.box, d, slack, settings_.glossyMargin);
     if (isBlack(fCos)) return Rgb(0.0f);
 
     const HomogeneousMedium* vrlMedium = node.medium >= 0 ? &scene_.media()[node.medium] : nullptr;

@@ -67,6 +67,14 @@ public:
     double minimumDistance(int32_t node, const Vec3& x) const;
     // Whether the bound is proven for the BSDF at x (diffuse) or a heuristic (glossy).
     static bool provenFor(const Bsdf& bsdf);
+    // The receiver's factor above, also the surface-VPL cut's at a surface point
+    // (surface_vpl_cut.h): a bound on f_s(x; wo, wi) |cos(wi, n_s)| over the
+    // directions wi from x to the points of `box`, at distance >= d > 0 from x
+    // (`slack`: the rounding margin of the caller's distances). 0 where the whole
+    // box lies behind a reflecting x; Lambertian: proven, glossy: the heuristic
+    // above with `glossyMargin`.
+    static Rgb reflectionTowardsBox(const CameraPathSurface& x, const Bsdf& bsdf, const Imath::Box3f& box, double d,
+                                    double slack, float glossyMargin);
 
 private:
     // The bound on f_p (see above) for the node's VRLs lighting x at distance >= d.

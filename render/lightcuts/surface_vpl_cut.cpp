@@ -2,6 +2,8 @@
 
 #include "render/core/distance.h"
 #include "render/lightcuts/cut_walk.h"
+#include "render/lightcuts/stochastic_cut.h"
+#include "render/lightcuts/surface_cluster_bound.h"
 #include "render/vrl/vrl_estimator.h"
 
 #include <algorithm>
@@ -32,6 +34,14 @@ Rgb surfaceVplReflectionBound(const Scene& scene, const SurfaceVpl& vpl) {
         largest = Rgb(std::max(largest.x, f.x), std::max(largest.y, f.y), std::max(largest.z, f.z));
     }
     return largest * 2.0f;
+}
+
+float surfaceVplRadius(const SurfaceVplLights& lights) {
+    if (lights.vpls.empty()) return 0.0f;
+    Imath::Box3f box;
+    for (const SurfaceVpl& vpl : lights.vpls) box.extendBy(vpl.position);
+    const float diagonal = (box.max - box.min).length();
+    return diagonal > 0.0f && std::isfinite(diagonal) ? kSurfaceVplRadiusFraction * diagonal : 0.0f;
 }
 
 SurfaceVplLights prepareSurfaceVpls(const Scene& scene, std::vector<SurfaceVpl> vpls, bool buildTree,
@@ -130,6 +140,69 @@ Rgb SurfaceVplLightcutsEstimator::bound(int32_t index, const CameraSegment& segm
            float(kRoundingMargin * phaseMax * geometry);
 }
 
+Rgb SurfaceVplLightcutsEstimator::bound(int32_t index, const CameraPathSurface& x, float radius) const {
+    const LightTreeNode& node = lights_.tree.nodes()[size_t(index)];
+    const Vec3& p = x.hit.position;
+    const float reach = std::max({std::abs(node.box.min.x), std::abs(node.box.min.y), std::abs(node.box.min.z),
+                                  std::abs(node.box.max.x), std::abs(node.box.max.y), std::abs(node.box.max.z)});
+    const double slack = 8.0 * 0x1p-24 * (double(p.length()) + reach);
+    const double d = distancePointBox(p, node.box) - slack;
+    // reflectionTowardsBox takes a positive distance: a tiny one where x may lie in the box (cosine bound 1).
+    const double dPositive = d > 0.0 ? d : 1e-30;
+    const SceneShape& shape = scene_.shapes()[x.hit.shape];
+    const Rgb fCos = SurfaceClusterBound::reflectionTowardsBox(x, shape.bsdf, node.box, dPositive, slack,
+                                                               settings_.bound.glossyMargin);
+    if (isBlack(fCos)) return Rgb(0.0f);
+    double cosine = 1.0;  // at y (surface_vpl_cut.h)
+    if (d > 0.0 && !normals_.empty() && normals_[size_t(index)].spread >= 0.0f && normals_[size_t(index)].spread < 1.0f) {
+        const NormalBound& n = normals_[size_t(index)];
+        const auto [lo, hi] = signedDistanceRange(node.box, n.axis, p);
+        cosine = std::min(1.0, (std::max(std::abs(lo), std::abs(hi)) + slack) / d + double(n.spread));
+    }
+    Rgb transmittance(1.0f);
+    const bool reflectsOnly = shape.bsdf.kind() != BsdfDescription::Kind::RoughDielectric;
+    if (d > 0.0 && node.medium >= 0 && node.medium == x.medium && reflectsOnly && !shape.changesMedium &&
+        scene_.media()[size_t(node.medium)].boundaryConvex())
+        transmittance = scene_.media()[size_t(node.medium)].transmittanceBound(d);
+    const double clamped = std::max(std::max(d, 0.0), double(radius));
+    return node.clusterFlux * fCos * transmittance * x.throughput *
+           float(kRoundingMargin * cosine / (clamped * clamped));
+}
+
+ChildImportances SurfaceVplLightcutsEstimator::importances(int32_t node, const CameraPathSurface& x,
+                                                          float radius) const {
+    const LightTreeNode& n = lights_.tree.nodes()[size_t(node)];
+    const auto importanceOf = [&](int32_t child) {
+        const Rgb b = bound(child, x, radius);
+        return double(b.x) + double(b.y) + double(b.z);
+    };
+    return ChildImportances{{n.left, n.right}, {importanceOf(n.left), importanceOf(n.right)}};
+}
+
+Rgb SurfaceVplLightcutsEstimator::sample(const CameraPathSurface& x, float radius, uint32_t cutSize, Rng& rng,
+                                         CutStatistics& statistics) const {
+    const LightTree& tree = lights_.tree;
+    if (tree.empty() || !(radius > 0.0f) || !lambertianBounded(scene_.shapes()[x.hit.shape].bsdf)) return Rgb(0.0f);
+    return stochasticCutEstimate(
+        tree, cutSize, rng, statistics, [&](int32_t node) { return importances(node, x, radius); },
+        [&](const int32_t* leaves, size_t count, Rng&, Rgb* out) {
+            for (size_t k = 0; k < count; ++k) {
+                const SurfaceVpl& vpl = lights_.vpls[size_t(leaves[k])];
+                out[k] = estimator_.contribution(vpl, vpl.flux, x, radius);
+            }
+        });
+}
+
+Rgb SurfaceVplLightcutsEstimator::representativeFlux(const LightTreeNode& node) const {
+    // Phi_r I_C / I_r = I_C / F_r where Phi_r > 0, and also where the representative
+    // carries no flux in a channel (a null collision of spectral tracking weighs 0
+    // there): its BSDF bound still scales the cluster's light in that channel.
+    const Rgb& reflection = reflection_[node.representative];
+    const auto scaled = [](float cluster, float bound) { return bound > 0.0f ? cluster / bound : 0.0f; };
+    return Rgb(scaled(node.clusterFlux.x, reflection.x), scaled(node.clusterFlux.y, reflection.y),
+               scaled(node.clusterFlux.z, reflection.z));
+}
+
 Rgb SurfaceVplLightcutsEstimator::estimate(const CameraSegment& segment, uint64_t streamKey, CutStatistics& statistics,
                                            float otherLuminance) const {
     const LightTree& tree = lights_.tree;
@@ -151,16 +224,8 @@ Rgb SurfaceVplLightcutsEstimator::estimate(const CameraSegment& segment, uint64_
         Rgb estimate(int32_t i) const {
             const LightTreeNode& node = self.lights_.tree.nodes()[size_t(i)];
             const uint32_t k = node.representative;
-            const SurfaceVpl& vpl = self.lights_.vpls[k];
-            // Phi_r I_C / I_r = I_C / F_r where Phi_r > 0, and also where the representative
-            // carries no flux in a channel (a null collision of spectral tracking weighs 0
-            // there): its BSDF bound still scales the cluster's light in that channel.
-            const Rgb& reflection = self.reflection_[k];
-            const auto scaled = [](float cluster, float bound) { return bound > 0.0f ? cluster / bound : 0.0f; };
-            const Rgb flux(scaled(node.clusterFlux.x, reflection.x), scaled(node.clusterFlux.y, reflection.y),
-                           scaled(node.clusterFlux.z, reflection.z));
             Rng rng = vrlStream(streamKey, k);
-            return self.estimator_.contribution(vpl, flux, segment, rng);
+            return self.estimator_.contribution(self.lights_.vpls[k], self.representativeFlux(node), segment, rng);
         }
     };
     return walkCut(tree, settings_, statistics, Visitor{*this, segment, streamKey}, otherLuminance);
@@ -173,6 +238,13 @@ Rgb sumOverSurfaceVpls(const SurfaceVplEstimator& estimator, const std::vector<S
         Rng rng = vrlStream(streamKey, k);
         sum += estimator.contribution(vpls[k], segment, rng);
     }
+    return sum;
+}
+
+Rgb sumOverSurfaceVpls(const SurfaceVplEstimator& estimator, const std::vector<SurfaceVpl>& vpls,
+                       const CameraPathSurface& x, float radius) {
+    Rgb sum(0.0f);
+    for (const SurfaceVpl& vpl : vpls) sum += estimator.contribution(vpl, vpl.flux, x, radius);
     return sum;
 }
 

@@ -2,6 +2,7 @@
 
 #include "render/vrl/vrl_estimator.h"
 
+#include <algorithm>
 #include <cmath>
 
 namespace vrl {
@@ -37,6 +38,31 @@ Rgb SurfaceVplEstimator::contribution(const SurfaceVpl& vpl, const Rgb& flux, co
     if (isBlack(between)) return Rgb(0.0f);
     const double scale = double(phase) / (double(r2) * double(us.pdf));
     return flux * f * between * medium.sigmaS() * medium.transmittance(us.t) * segment.throughputBefore * float(scale);
+}
+
+Rgb SurfaceVplEstimator::contribution(const SurfaceVpl& vpl, const Rgb& flux, const CameraPathSurface& x,
+                                      float radius) const {
+    if (!lambertianBounded(scene_.shapes()[x.hit.shape].bsdf)) return Rgb(0.0f);
+    const Bsdf& bsdf = scene_.shapes()[vpl.shape].bsdf;
+    const Vec3 toX = x.hit.position - vpl.position;
+    const float r2 = toX.length2();
+    if (!(r2 > 0.0f) || !std::isfinite(r2)) return Rgb(0.0f);
+    const float r = std::sqrt(r2);
+    const Vec3 w = toX / r;
+    const Rgb fx = x.bsdf.eval(-w, TransportMode::Radiance);
+    if (isBlack(fx)) return Rgb(0.0f);
+    const SurfaceHit y = surfaceHitOf(vpl);
+    const Rgb fy = bsdf.eval(y.shadingPoint(), -vpl.direction, w, TransportMode::Importance);
+    if (isBlack(fy)) return Rgb(0.0f);
+    // Visibility between offset origins at both ends; the stretches they skip lie in
+    // the medium between, whose transmittance is taken over the whole distance r.
+    const int between = scene_.mediumAfter(y, w, vpl.medium);
+    const Vec3 from = Scene::offsetOrigin(y, w), to = Scene::offsetOrigin(x.hit, -w);
+    Rgb transmittance = scene_.transmittance(from, to, between);
+    if (isBlack(transmittance)) return Rgb(0.0f);
+    if (between >= 0) transmittance *= scene_.media()[size_t(between)].transmittance(r - (to - from).length());
+    const float clamped = std::max(r2, radius * radius);
+    return flux * fy * fx * transmittance * x.throughput * (1.0f / clamped);
 }
 
 std::optional<Rgb> SurfaceVplEstimator::reflectionBound(const SurfaceVpl& vpl) const {

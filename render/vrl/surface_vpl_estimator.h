@@ -1,5 +1,7 @@
 // SurfaceVplEstimator: the light one surface VPL (surface_vpl.h) sends into a
-// camera segment, scattered towards the camera there: part (b)'s paths whose
+// camera segment, scattered towards the camera there (and, below the segment
+// estimator, the light it sends to a camera path's surface point, part (a)'s
+// share): part (b)'s paths whose
 // first vertex x1 lies on the camera segment, in the medium, and whose second
 // vertex x2 is a surface vertex that reflects by a non-Dirac lobe
 // (transport_parts.h). It is the dual of part (c) (vrl_surface_estimator.h):
@@ -47,6 +49,12 @@
 
 namespace vrl {
 
+// Part (a)'s split applies at points x1 whose non-Dirac part is Lambertian
+// (diffuse, smooth plastic: Bsdf::lambertianBound).
+inline bool lambertianBounded(const Bsdf& bsdf) {
+    return bsdf.kind() == BsdfDescription::Kind::Diffuse || bsdf.kind() == BsdfDescription::Kind::Plastic;
+}
+
 // The VPL's vertex as the hit record the scene's functions take.
 inline SurfaceHit surfaceHitOf(const SurfaceVpl& vpl) {
     SurfaceHit hit;
@@ -78,6 +86,23 @@ public:
     Rgb contribution(const SurfaceVpl& vpl, const CameraSegment& segment, Rng& rng) const {
         return contribution(vpl, vpl.flux, segment, rng);
     }
+
+    // Part (a)'s share (transport_integrator.h): the light the VPL sends to the camera
+    // path's surface point x unscattered, reflected there by x's non-Dirac lobes,
+    // with the inverse square clamped at distance R (below):
+    //   Phi f_s(y; -w_in -> w) T_r(y, x) V(y, x) f_s(x; wo, -w) / max(|x - y|, R)^2,
+    // w = (x - y) / |x - y|, f_s at y in importance mode and at x in radiance mode,
+    // both with their cosines, times x.throughput. Deterministic: no sample is drawn.
+    // The clamp makes the estimate bounded (instant radiosity's splotches near
+    // corners, where 1/d^2 grows without bound, are gone); the path tracer adds the
+    // rest, (1/d^2 - 1/R^2) for d < R, so the sum stays unbiased
+    // (PathStart::surfaceVplRadius; after Kollig & Keller 2004's bias compensation).
+    // 0 where x coincides with y, for a grazing or back-facing direction at either end,
+    // and unless x's model is Lambertian-bounded (lambertianBounded): a glossy x stays
+    // with the path tracer, since it sees the VPLs in its lobe as spikes (staircase's
+    // glossy floor: part (a)'s noise x2.4). VPLs on glossy surfaces do take part:
+    // they carry veach-lamp's light from its reflector to the walls.
+    Rgb contribution(const SurfaceVpl& vpl, const Rgb& flux, const CameraPathSurface& x, float radius) const;
 
     // A bound on f_s(y; -w_in -> w) over every w (cosine included) for VPLs on
     // surfaces whose non-Dirac part is Lambertian (Bsdf::lambertianBound): rho/pi

@@ -8,6 +8,8 @@
 
 #include <grpcpp/grpcpp.h>
 
+#include "vrl/v1/vrl.pb.h"
+
 #include <csignal>
 
 #include <chrono>
@@ -19,7 +21,9 @@
 
 namespace vrl::rpc {
 
-inline constexpr uint32_t kProtocolVersion = 6;          // vrl.v1 ProtocolVersion CURRENT
+inline constexpr uint32_t kProtocolVersion = 8;          // vrl.v1 ProtocolVersion CURRENT
+static_assert(kProtocolVersion == uint32_t(::vrl::v1::PROTOCOL_VERSION_CURRENT),
+              "the handshake's protocol version must be the proto's PROTOCOL_VERSION_CURRENT");
 inline constexpr size_t kChunkBytes = 1 << 20;           // streamed blobs: at most 1 MiB per message
 inline constexpr int kMaxMessageBytes = 64 << 20;        // a tile result of 64 MiB at most (e.g. 256x256 x 8 layers)
 inline constexpr std::chrono::milliseconds kKeepaliveTime{20000};

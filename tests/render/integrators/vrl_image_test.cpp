@@ -215,6 +215,42 @@ TEST(VrlImage, PartsSumToReferenceInLitRoomWithOccluder) {
     }
 }
 
+// Part (a) alone with vrl-lightcuts, its light from non-Dirac reflections at x2
+// sampled from the surface VPLs per camera sample (the inverse square clamped,
+// path tracing adding the rest within R), equals part (a) path-traced alone
+// (--surface-vpls 0): the split is unbiased. The lit room (grey and HG media)
+// and the shared Cornell box.
+RunStatistics surfacePartRuns(const Scene& scene, uint64_t surfaceVplLimit) {
+    return overRuns([&](uint64_t seed) {
+        RenderSettings settings;
+        settings.method = RenderMethod::VrlLightcuts;
+        settings.transports = TransportSelection::parse("surface");
+        settings.samplesPerPixel = kPartsSpp;
+        settings.vrlCount = kVrls;
+        settings.surfaceVplLimit = surfaceVplLimit;
+        settings.seed = seed;
+        return render(scene, settings).image;
+    });
+}
+
+TEST(VrlImage, SurfacePartWithSurfaceVplsEqualsPathTracedSurfacePart) {
+    std::vector<std::pair<std::string, std::unique_ptr<Scene>>> scenes;
+    for (const MediumCase& m : {kMedia[0], kMedia[2]})
+        scenes.emplace_back(m.name, Scene::build(test::litRoomWithOccluder(m.sigmaS * 0.5f, m.sigmaA * 0.5f, m.g)));
+    const std::filesystem::path file = std::filesystem::path(VRL_SHARED_SCENES_DIR) / "lajolla-volpath-test/vol_cbox.xml";
+    if (std::filesystem::exists(file)) {
+        SceneDescription description = parseMitsubaScene(file);
+        description.sensor.width = description.sensor.height = 16;
+        scenes.emplace_back("vol_cbox", Scene::build(description));
+    } else {
+        std::printf("shared scene %s is absent: the lit room only\n", file.c_str());
+    }
+    for (const auto& [name, scene] : scenes) {
+        expectAgree(surfacePartRuns(*scene, kAutoSurfaceVpls), surfacePartRuns(*scene, 0),
+                    (name + " (a) with surface VPLs").c_str());
+    }
+}
+
 TEST(VrlImage, MultipleScatteringEqualsRestrictedReference) {
     for (const MediumCase& m : kMedia) {
         const auto scene = Scene::build(test::litRoomWithOccluder(m.sigmaS * 0.5f, m.sigmaA * 0.5f, m.g));
@@ -255,7 +291,7 @@ TEST(VrlImage, LayersAreThePartsAndSumToTheImage) {
     }
     settings.transports = TransportSelection::parse("single,multiple");
     EXPECT_EQ(render(*scene, settings).layers.size(), 3u);
-    settings.transports = TransportSelection::parse("surface,multiple");  // no (b): no surface VPLs
+    settings.transports = TransportSelection::parse("surface,multiple");  // no (b): no surface VPL layer
     EXPECT_EQ(render(*scene, settings).layers.size(), 2u);
     EXPECT_THROW(TransportSelection::parse("single,bogus"), std::invalid_argument);
 }
