@@ -46,10 +46,12 @@
 #include "render/vrl/camera_segment.h"
 #include "render/vrl/light_tracer.h"
 #include "render/vrl/vrl_estimator.h"
+#include "tests/support/light_tree_order.h"
 #include "tests/support/test_scenes.h"
 
 #include <gtest/gtest.h>
 
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -196,10 +198,62 @@ CameraSegment randomSegment(const Scene& scene, const SurfaceVplLights& lights, 
     return s;
 }
 
+// The three Lambertian-bounded models the bound tests use: one-sided and two-sided
+// diffuse, smooth plastic.
+std::array<BsdfDescription, 3> lambertianBoundedBsdfs() {
+    BsdfDescription plastic;
+    plastic.kind = BsdfDescription::Kind::Plastic;
+    plastic.reflectance.value = Rgb(0.6f, 0.3f, 0.2f);
+    return {test::diffuseBsdf(Rgb(0.7f, 0.5f, 0.3f), false), test::diffuseBsdf(Rgb(0.7f, 0.5f, 0.3f), true), plastic};
+}
+
+// A node's representative VPL with the flux the cut gives it (Visitor::estimate):
+// Phi_r I_C / I_r per channel (I: the proxies' intensities).
+Rgb asRepresentative(const SurfaceVpl& vpl, const LightTreeNode& node, const Rgb& I) {
+    const auto scaled = [](float phi, float cluster, float own) { return own > 0.0f ? phi * (cluster / own) : 0.0f; };
+    return Rgb(scaled(vpl.flux.x, node.clusterFlux.x, I.x), scaled(vpl.flux.y, node.clusterFlux.y, I.y),
+               scaled(vpl.flux.z, node.clusterFlux.z, I.z));
+}
+
+// The largest estimate_k / I_k over node's VPLs, channel-wise: the leaf's own, or
+// the larger of its children's (visited first: test::childrenBeforeParents).
+Rgb largestPerIntensity(const LightTreeNode& node, const std::vector<Rgb>& own, const std::vector<Vrl>& intensity,
+                        const std::vector<Rgb>& largest) {
+    if (node.isLeaf()) {
+        const Rgb& e = own[node.representative];
+        const Rgb& I = intensity[node.representative].flux;
+        const auto ratio = [](float estimate, float bound) { return bound > 0.0f ? estimate / bound : 0.0f; };
+        return Rgb(ratio(e.x, I.x), ratio(e.y, I.y), ratio(e.z, I.z));
+    }
+    const Rgb& l = largest[size_t(node.left)];
+    const Rgb& r = largest[size_t(node.right)];
+    return Rgb(std::max(l.x, r.x), std::max(l.y, r.y), std::max(l.z, r.z));
+}
+
 struct Tally {
     uint64_t triples = 0, violations = 0, infinite = 0;
     uint64_t vplChecks = 0, vplViolations = 0;
     double worstRatio = 0.0, worstInnerRatio = 0.0, worstVplRatio = 0.0;
+
+    // One node against query j (of kind `kind`): its estimate e and every VPL's
+    // (largest estimate_k / I_k below, times I_C) against its bound b, per channel.
+    void add(const Rgb& e, const Rgb& b, const Rgb& perVpl, bool leaf, const char* query, int j, int kind, int32_t node) {
+        for (int c = 0; c < 3; ++c) {
+            if (e[c] > b[c]) {
+                if (violations < 5)
+                    std::printf("  violation: %s %d (kind %d) node %d channel %d estimate %g bound %g\n", query, j, kind,
+                                node, c, e[c], b[c]);
+                ++violations;
+            }
+            ++vplChecks;
+            if (perVpl[c] > b[c]) ++vplViolations;
+            if (b[c] > 0.0f) {
+                worstRatio = std::max(worstRatio, double(e[c]) / double(b[c]));
+                if (!leaf) worstInnerRatio = std::max(worstInnerRatio, double(e[c]) / double(b[c]));
+                worstVplRatio = std::max(worstVplRatio, double(perVpl[c]) / double(b[c]));
+            }
+        }
+    }
 };
 
 Tally checkBound(const Scene& scene, uint64_t seed, int vplCount, int segments) {
@@ -212,22 +266,8 @@ Tally checkBound(const Scene& scene, uint64_t seed, int vplCount, int segments) 
     const auto& intensity = lights.tree.vrls();  // I_k, in the VPLs' order
     EXPECT_EQ(intensity.size(), lights.vpls.size());
     EXPECT_GT(lights.vpls.size(), size_t(vplCount) * 8 / 10) << "most VPLs reflect something";
-    // Children before parents.
-    std::vector<int32_t> order;
-    std::vector<std::pair<int32_t, bool>> stack{{lights.tree.root(), false}};
-    while (!stack.empty()) {
-        auto [i, expanded] = stack.back();
-        stack.pop_back();
-        if (expanded || nodes[i].isLeaf()) {
-            order.push_back(i);
-            continue;
-        }
-        stack.push_back({i, true});
-        stack.push_back({nodes[i].left, false});
-        stack.push_back({nodes[i].right, false});
-    }
+    const std::vector<int32_t> order = test::childrenBeforeParents(lights.tree);
     EXPECT_EQ(order.size(), nodes.size());
-    const auto scaled = [](float phi, float cluster, float own) { return own > 0.0f ? phi * (cluster / own) : 0.0f; };
     std::vector<Rgb> own(lights.vpls.size());
     std::vector<Rgb> largest(nodes.size());  // largest estimate_k / I_k below, channel-wise
     Tally tally;
@@ -241,16 +281,7 @@ Tally checkBound(const Scene& scene, uint64_t seed, int vplCount, int segments) 
         }
         for (int32_t i : order) {
             const LightTreeNode& node = nodes[i];
-            if (node.isLeaf()) {
-                const uint32_t k = node.representative;
-                const Rgb& e = own[k];
-                const Rgb& I = intensity[k].flux;
-                largest[i] = Rgb(scaled(e.x, 1.0f, I.x), scaled(e.y, 1.0f, I.y), scaled(e.z, 1.0f, I.z));
-            } else {
-                const Rgb& l = largest[node.left];
-                const Rgb& r = largest[node.right];
-                largest[i] = Rgb(std::max(l.x, r.x), std::max(l.y, r.y), std::max(l.z, r.z));
-            }
+            largest[i] = largestPerIntensity(node, own, intensity, largest);
             const Rgb b = cut.bound(i, s);
             ++tally.triples;
             if (!std::isfinite(b.x + b.y + b.z)) {
@@ -260,39 +291,17 @@ Tally checkBound(const Scene& scene, uint64_t seed, int vplCount, int segments) 
             // The cut's estimate of the node (Visitor::estimate).
             const uint32_t k = node.representative;
             const SurfaceVpl& vpl = lights.vpls[k];
-            const Rgb& I = intensity[k].flux;
-            const Rgb flux(scaled(vpl.flux.x, node.clusterFlux.x, I.x), scaled(vpl.flux.y, node.clusterFlux.y, I.y),
-                           scaled(vpl.flux.z, node.clusterFlux.z, I.z));
+            const Rgb flux = asRepresentative(vpl, node, intensity[k].flux);
             Rng stream = vrlStream(key, k);
             const Rgb e = estimator.contribution(vpl, flux, s, stream);
-            for (int c = 0; c < 3; ++c) {
-                if (e[c] > b[c]) {
-                    if (tally.violations < 5)
-                        std::printf("  violation: segment %d (kind %d) node %d channel %d estimate %g bound %g\n", j,
-                                    j % 6, i, c, e[c], b[c]);
-                    ++tally.violations;
-                }
-                const float perVpl = largest[i][c] * node.clusterFlux[c];
-                ++tally.vplChecks;
-                if (perVpl > b[c]) ++tally.vplViolations;
-                if (b[c] > 0.0f) {
-                    tally.worstRatio = std::max(tally.worstRatio, double(e[c]) / double(b[c]));
-                    if (!node.isLeaf())
-                        tally.worstInnerRatio = std::max(tally.worstInnerRatio, double(e[c]) / double(b[c]));
-                    tally.worstVplRatio = std::max(tally.worstVplRatio, double(perVpl) / double(b[c]));
-                }
-            }
+            tally.add(e, b, largest[i] * node.clusterFlux, node.isLeaf(), "segment", j, j % 6, i);
         }
     }
     return tally;
 }
 
 TEST(SurfaceVplCut, BoundNeverExceededForDiffuseAndSmoothPlastic) {
-    BsdfDescription plastic;
-    plastic.kind = BsdfDescription::Kind::Plastic;
-    plastic.reflectance.value = Rgb(0.6f, 0.3f, 0.2f);
-    const BsdfDescription bsdfs[] = {test::diffuseBsdf(Rgb(0.7f, 0.5f, 0.3f), false),
-                                     test::diffuseBsdf(Rgb(0.7f, 0.5f, 0.3f), true), plastic};
+    const std::array<BsdfDescription, 3> bsdfs = lambertianBoundedBsdfs();
     const char* bsdfNames[] = {"diffuse", "diffuse two-sided", "plastic"};
     const auto start = std::chrono::steady_clock::now();
     uint64_t total = 0, seed = 100;
@@ -524,20 +533,7 @@ Tally checkPointBound(const Scene& scene, uint64_t seed, int vplCount, int recei
     const SurfaceVplLightcutsEstimator cut(scene, lights, estimator, CutSettings{});
     const auto& nodes = lights.tree.nodes();
     const auto& intensity = lights.tree.vrls();
-    std::vector<int32_t> order;  // children before parents
-    std::vector<std::pair<int32_t, bool>> stack{{lights.tree.root(), false}};
-    while (!stack.empty()) {
-        auto [i, expanded] = stack.back();
-        stack.pop_back();
-        if (expanded || nodes[i].isLeaf()) {
-            order.push_back(i);
-            continue;
-        }
-        stack.push_back({i, true});
-        stack.push_back({nodes[i].left, false});
-        stack.push_back({nodes[i].right, false});
-    }
-    const auto scaled = [](float phi, float cluster, float own) { return own > 0.0f ? phi * (cluster / own) : 0.0f; };
+    const std::vector<int32_t> order = test::childrenBeforeParents(lights.tree);
     std::vector<Rgb> own(lights.vpls.size()), largest(nodes.size());
     Tally tally;
     for (int j = 0; j < receivers; ++j) {
@@ -549,53 +545,22 @@ Tally checkPointBound(const Scene& scene, uint64_t seed, int vplCount, int recei
         }
         for (int32_t i : order) {
             const LightTreeNode& node = nodes[i];
-            if (node.isLeaf()) {
-                const uint32_t k = node.representative;
-                const Rgb& e = own[k];
-                const Rgb& I = intensity[k].flux;
-                largest[i] = Rgb(scaled(e.x, 1.0f, I.x), scaled(e.y, 1.0f, I.y), scaled(e.z, 1.0f, I.z));
-            } else {
-                const Rgb& l = largest[node.left];
-                const Rgb& r = largest[node.right];
-                largest[i] = Rgb(std::max(l.x, r.x), std::max(l.y, r.y), std::max(l.z, r.z));
-            }
+            largest[i] = largestPerIntensity(node, own, intensity, largest);
             const Rgb b = cut.bound(i, x, radius);
             ++tally.triples;
             EXPECT_TRUE(std::isfinite(b.x + b.y + b.z)) << "the clamp makes every bound finite";
             const uint32_t k = node.representative;
             const SurfaceVpl& vpl = lights.vpls[k];
-            const Rgb& I = intensity[k].flux;
-            const Rgb flux(scaled(vpl.flux.x, node.clusterFlux.x, I.x), scaled(vpl.flux.y, node.clusterFlux.y, I.y),
-                           scaled(vpl.flux.z, node.clusterFlux.z, I.z));
+            const Rgb flux = asRepresentative(vpl, node, intensity[k].flux);
             const Rgb e = estimator.contribution(vpl, flux, x, radius);
-            for (int c = 0; c < 3; ++c) {
-                if (e[c] > b[c]) {
-                    if (tally.violations < 5)
-                        std::printf("  violation: receiver %d (kind %d) node %d channel %d estimate %g bound %g\n", j,
-                                    j % 4, i, c, e[c], b[c]);
-                    ++tally.violations;
-                }
-                const float perVpl = largest[i][c] * node.clusterFlux[c];
-                ++tally.vplChecks;
-                if (perVpl > b[c]) ++tally.vplViolations;
-                if (b[c] > 0.0f) {
-                    tally.worstRatio = std::max(tally.worstRatio, double(e[c]) / double(b[c]));
-                    if (!node.isLeaf())
-                        tally.worstInnerRatio = std::max(tally.worstInnerRatio, double(e[c]) / double(b[c]));
-                    tally.worstVplRatio = std::max(tally.worstVplRatio, double(perVpl) / double(b[c]));
-                }
-            }
+            tally.add(e, b, largest[i] * node.clusterFlux, node.isLeaf(), "receiver", j, j % 4, i);
         }
     }
     return tally;
 }
 
 TEST(SurfaceVplCut, PointBoundNeverExceededForDiffuseAndSmoothPlastic) {
-    BsdfDescription plastic;
-    plastic.kind = BsdfDescription::Kind::Plastic;
-    plastic.reflectance.value = Rgb(0.6f, 0.3f, 0.2f);
-    const BsdfDescription bsdfs[] = {test::diffuseBsdf(Rgb(0.7f, 0.5f, 0.3f), false),
-                                     test::diffuseBsdf(Rgb(0.7f, 0.5f, 0.3f), true), plastic};
+    const std::array<BsdfDescription, 3> bsdfs = lambertianBoundedBsdfs();
     const char* bsdfNames[] = {"diffuse", "diffuse two-sided", "plastic"};
     uint64_t total = 0, seed = 300;
     double worst = 0.0;

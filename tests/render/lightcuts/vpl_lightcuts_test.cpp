@@ -9,6 +9,7 @@
 #include "render/renderer.h"
 #include "render/scene/scene.h"
 #include "render/vrl/light_tracer.h"
+#include "tests/support/light_tree_order.h"
 #include "tests/support/test_scenes.h"
 
 #include <gtest/gtest.h>
@@ -265,22 +266,7 @@ void expectConservativeBound(const Scene& scene, const char* name) {
     const auto& nodes = tree.nodes();
     const auto& vpls = tree.vrls();
     const size_t n = vpls.size();
-    // Children before parents (post-order), without assuming the storage order.
-    std::vector<int32_t> order;
-    {
-        std::vector<std::pair<int32_t, bool>> stack{{tree.root(), false}};
-        while (!stack.empty()) {
-            auto [i, expanded] = stack.back();
-            stack.pop_back();
-            if (expanded || nodes[i].isLeaf()) {
-                order.push_back(i);
-                continue;
-            }
-            stack.push_back({i, true});
-            stack.push_back({nodes[i].left, false});
-            stack.push_back({nodes[i].right, false});
-        }
-    }
+    const std::vector<int32_t> order = test::childrenBeforeParents(tree);
     ASSERT_EQ(order.size(), nodes.size());
     const int medium = 0;
     Rng rng(17, 0);
