@@ -5,6 +5,7 @@
 #include "render/integrators/transport_integrator.h"
 #include "render/lightcuts/direction_cone.h"
 #include "render/lightcuts/leaf_segments.h"
+#include "render/lightcuts/surface_vpl_cut.h"
 #include "render/lightcuts/vrl_importance.h"
 #include "render/vrl/light_tracer.h"
 #include "render/vrl/vrl_lanes.h"
@@ -244,12 +245,14 @@ uint64_t estimateLightMemoryBytes(const RenderSettings& settings) {
     if (settings.method == RenderMethod::Vrl) perLight += double(VrlLanes::kBytesPerVrl);
     // Surface VPLs (part (b)): their limit (by default one per VRL: a light path meets
     // about as many surfaces as it leaves segments in a medium that fills the scene),
-    // twice while traced, and for the cut its proxies, nodes and build scratch.
+    // twice while traced, and for the cut its proxies, nodes, build scratch and the
+    // estimator's per-VPL record (its BSDF prepared, its bound).
     double perSurfaceVpl = 0.0;
     if (usesSurfaceVpls(settings)) {
         perSurfaceVpl = 2.0 * sizeof(SurfaceVpl);
         if (usesLightTree(settings.method) || surfaceVplsLightSurfaces(settings))
-            perSurfaceVpl += sizeof(Vrl) + 2.0 * sizeof(LightTreeNode) + double(LightTree::buildScratchBytesPerVrl());
+            perSurfaceVpl += sizeof(Vrl) + 2.0 * sizeof(LightTreeNode) + double(LightTree::buildScratchBytesPerVrl()) +
+                             double(SurfaceVplLightcutsEstimator::kBytesPerVpl);
     }
     const double bytes = perLight * double(settings.vrlCount) * double(std::max(1, settings.vrlSets)) +
                          perSurfaceVpl * double(surfaceVplLimit(settings));

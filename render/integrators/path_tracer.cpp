@@ -139,10 +139,12 @@ Rgb VolumetricPathTracer::radiance(Ray ray, int medium, Rng& rng, const PathStar
         // x2 of part (a) with surface VPLs: its non-Dirac reflection weighs 1 - (d/R)^2 (PathStart).
         float nonDiracWeight = 1.0f;
         if (x1ForVpls && !specularChain) {  // x2 (specularChain is false past x1)
-            const float d2 = (hit->position - *x1ForVpls).length2();
-            const float r2 = start.surfaceVplRadius * start.surfaceVplRadius;
-            nonDiracWeight = d2 < r2 ? 1.0f - d2 / r2 : 0.0f;
-            if (!(nonDiracWeight > 0.0f)) onlyDiracNext = true;
+            if (reflectsBroadly(bsdf)) {
+                const float d2 = (hit->position - *x1ForVpls).length2();
+                const float r2 = start.surfaceVplRadius * start.surfaceVplRadius;
+                nonDiracWeight = d2 < r2 ? 1.0f - d2 / r2 : 0.0f;
+                if (!(nonDiracWeight > 0.0f)) onlyDiracNext = true;
+            }
             x1ForVpls.reset();
         }
         if (Scene::withinCrossing(ray, *hit)) medium = mediumBeforeCrossing;

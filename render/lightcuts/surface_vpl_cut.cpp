@@ -75,9 +75,14 @@ SurfaceVplLightcutsEstimator::SurfaceVplLightcutsEstimator(const Scene& scene, c
     const LightTree& tree = lights.tree;
     if (tree.empty()) return;
     reflection_.reserve(lights.vpls.size());
-    for (const SurfaceVpl& vpl : lights.vpls) reflection_.push_back(surfaceVplReflectionBound(scene, vpl));
+    atVpl_.reserve(lights.vpls.size());
+    for (const SurfaceVpl& vpl : lights.vpls) {
+        reflection_.push_back(surfaceVplReflectionBound(scene, vpl));
+        atVpl_.push_back(estimator.prepareAt(vpl));
+    }
     const auto& nodes = tree.nodes();
     normals_.assign(nodes.size(), NormalBound{});
+    broadIntensity_.assign(nodes.size(), Rgb(0.0f));
     // Post-order from the root (children before their parent), without recursion.
     std::vector<std::pair<int32_t, bool>> stack{{tree.root(), false}};
     while (!stack.empty()) {
@@ -88,6 +93,7 @@ SurfaceVplLightcutsEstimator::SurfaceVplLightcutsEstimator(const Scene& scene, c
             const SurfaceVpl& vpl = lights.vpls[node.representative];
             const bool lambertian = scene.shapes()[vpl.shape].bsdf.lambertianBound(vpl.uv).has_value();
             normals_[size_t(i)] = NormalBound{vpl.geometricNormal, lambertian ? 0.0f : -1.0f};
+            if (reflectsBroadly(scene.shapes()[vpl.shape].bsdf)) broadIntensity_[size_t(i)] = node.clusterFlux;
             continue;
         }
         if (!childrenDone) {
@@ -96,6 +102,7 @@ SurfaceVplLightcutsEstimator::SurfaceVplLightcutsEstimator(const Scene& scene, c
             stack.push_back({node.right, false});
             continue;
         }
+        broadIntensity_[size_t(i)] = broadIntensity_[size_t(node.left)] + broadIntensity_[size_t(node.right)];
         const NormalBound& l = normals_[size_t(node.left)];
         const NormalBound& r = normals_[size_t(node.right)];
         if (l.spread < 0.0f || r.spread < 0.0f) continue;  // stays "no cosine factor"
@@ -142,6 +149,8 @@ Rgb SurfaceVplLightcutsEstimator::bound(int32_t index, const CameraSegment& segm
 
 Rgb SurfaceVplLightcutsEstimator::bound(int32_t index, const CameraPathSurface& x, float radius) const {
     const LightTreeNode& node = lights_.tree.nodes()[size_t(index)];
+    const Rgb& intensity = broadIntensity_[size_t(index)];  // only the VPLs part (a) takes
+    if (isBlack(intensity)) return Rgb(0.0f);
     const Vec3& p = x.hit.position;
     const float reach = std::max({std::abs(node.box.min.x), std::abs(node.box.min.y), std::abs(node.box.min.z),
                                   std::abs(node.box.max.x), std::abs(node.box.max.y), std::abs(node.box.max.z)});
@@ -165,8 +174,7 @@ Rgb SurfaceVplLightcutsEstimator::bound(int32_t index, const CameraPathSurface& 
         scene_.media()[size_t(node.medium)].boundaryConvex())
         transmittance = scene_.media()[size_t(node.medium)].transmittanceBound(d);
     const double clamped = std::max(std::max(d, 0.0), double(radius));
-    return node.clusterFlux * fCos * transmittance * x.throughput *
-           float(kRoundingMargin * cosine / (clamped * clamped));
+    return intensity * fCos * transmittance * x.throughput * float(kRoundingMargin * cosine / (clamped * clamped));
 }
 
 ChildImportances SurfaceVplLightcutsEstimator::importances(int32_t node, const CameraPathSurface& x,
@@ -188,7 +196,7 @@ Rgb SurfaceVplLightcutsEstimator::sample(const CameraPathSurface& x, float radiu
         [&](const int32_t* leaves, size_t count, Rng&, Rgb* out) {
             for (size_t k = 0; k < count; ++k) {
                 const SurfaceVpl& vpl = lights_.vpls[size_t(leaves[k])];
-                out[k] = estimator_.contribution(vpl, vpl.flux, x, radius);
+                out[k] = estimator_.contribution(vpl, atVpl_[size_t(leaves[k])], vpl.flux, x, radius);
             }
         });
 }
@@ -215,7 +223,8 @@ Rgb SurfaceVplLightcutsEstimator::estimate(const CameraSegment& segment, uint64_
         Rgb leaf(int32_t i) const {
             const uint32_t k = self.lights_.tree.nodes()[size_t(i)].representative;
             Rng rng = vrlStream(streamKey, k);
-            return self.estimator_.contribution(self.lights_.vpls[k], segment, rng);
+            return self.estimator_.contribution(self.lights_.vpls[k], self.atVpl_[k], self.lights_.vpls[k].flux, segment,
+                                                rng);
         }
         bool bound(int32_t i, Rgb& b) const {
             b = self.bound(i, segment);
@@ -225,7 +234,8 @@ Rgb SurfaceVplLightcutsEstimator::estimate(const CameraSegment& segment, uint64_
             const LightTreeNode& node = self.lights_.tree.nodes()[size_t(i)];
             const uint32_t k = node.representative;
             Rng rng = vrlStream(streamKey, k);
-            return self.estimator_.contribution(self.lights_.vpls[k], self.representativeFlux(node), segment, rng);
+            return self.estimator_.contribution(self.lights_.vpls[k], self.atVpl_[k], self.representativeFlux(node),
+                                                segment, rng);
         }
     };
     return walkCut(tree, settings_, statistics, Visitor{*this, segment, streamKey}, otherLuminance);

@@ -67,7 +67,9 @@
 // node's VPLs (the proxy's medium) and x lie in one medium with a convex boundary,
 // x's shape bounding no medium, so the segment x-y stays inside it, else 1. Sum
 // over the representative's weighting as above: at most I_C c_y F_x T / max(d, R)^2.
-// The clamp makes every bound finite, even for a box that holds x. Part (a) takes
+// Only the VPLs part (a) takes (reflectsBroadly) contribute; the others give 0, so
+// I_C there sums the I_k of those alone (0 for a node of narrow-lobe VPLs, never
+// drawn). The clamp makes every bound finite, even for a box that holds x. Part (a) takes
 // this bound as the importance of a stochastic cut (sample, below): VPLs are drawn
 // in proportion to it, so a draw's estimate / probability stays near the node's
 // bound where visibility and the cosines are near their bounds.
@@ -120,6 +122,10 @@ public:
     // `lights` must hold a tree built by prepareSurfaceVpls for this scene.
     SurfaceVplLightcutsEstimator(const Scene& scene, const SurfaceVplLights& lights,
                                  const SurfaceVplEstimator& estimator, CutSettings settings);
+    // What the estimator keeps per VPL besides the lights (for memory estimates).
+    // (Per VPL: its bound and prepared BSDF; per node, two per VPL: the normal bound
+    // and part (a)'s flux.)
+    static constexpr size_t kBytesPerVpl = sizeof(Rgb) + sizeof(PreparedBsdf) + 2 * (sizeof(Vec3) + sizeof(float) + sizeof(Rgb));
 
     // The medium-then-surface light along `segment` from every VPL, by a cut.
     Rgb estimate(const CameraSegment& segment, uint64_t streamKey, CutStatistics& statistics,
@@ -155,7 +161,14 @@ private:
     const SurfaceVplEstimator& estimator_;
     CutSettings settings_;
     std::vector<NormalBound> normals_;
+    // Per node: I_C over the VPLs below that part (a) takes (reflectsBroadly), the
+    // intensity its point bound carries in place of the cluster's.
+    std::vector<Rgb> broadIntensity_;
     std::vector<Rgb> reflection_;  // F_k per VPL (surfaceVplReflectionBound), for the representatives' flux
+    // Each VPL's BSDF prepared for its arrival (SurfaceVplEstimator::prepareAt): a VPL
+    // is evaluated at many camera points, and its texture reads and shading frame
+    // were a tenth of staircase's render time (kBytesPerVpl each).
+    std::vector<PreparedBsdf> atVpl_;
     // A node's flux as its representative carries it: I_C / F_r per channel (above).
     Rgb representativeFlux(const LightTreeNode& node) const;
 };

@@ -448,6 +448,18 @@ std::optional<Rgb> Bsdf::lambertianBound(const Vec2& uv) const {
     return std::nullopt;
 }
 
+float Bsdf::glossyRoughness() const {
+    switch (kind_) {
+    case Kind::RoughDielectric:
+    case Kind::RoughConductor:
+    case Kind::RoughPlastic:
+    case Kind::Ward:
+        return std::min(alphaU_, alphaV_);
+    default:
+        return 0.0f;
+    }
+}
+
 std::optional<Rgb> PreparedBsdf::lambertianBound() const {
     if (!bsdf_) return Rgb(0.0f);
     return bsdf_->lambertianBoundOf(lookups_.diffuse);

@@ -111,6 +111,9 @@ public:
     // (its diffuse base through the coating, (1 - F) <= 1). Empty for the others
     // (glossy lobes, purely specular and null models).
     std::optional<Rgb> lambertianBound(const Vec2& uv) const;
+    // The glossy lobe's roughness: the smaller of alpha_u and alpha_v for the rough
+    // (microfacet) models and Ward; 0 for models without a glossy lobe.
+    float glossyRoughness() const;
     // Hemispherical reflectance estimate (for previews and light-tree weights): the
     // diffuse colour, or the specular colour for metals and glass.
     Rgb albedo(const Vec2& uv) const;

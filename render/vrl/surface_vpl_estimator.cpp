@@ -7,8 +7,8 @@
 
 namespace vrl {
 
-Rgb SurfaceVplEstimator::contribution(const SurfaceVpl& vpl, const Rgb& flux, const CameraSegment& segment,
-                                      Rng& rng) const {
+Rgb SurfaceVplEstimator::contribution(const SurfaceVpl& vpl, const PreparedBsdf& atVpl, const Rgb& flux,
+                                      const CameraSegment& segment, Rng& rng) const {
     if (!(segment.length > 0.0f) || segment.medium < 0) return Rgb(0.0f);
     const HomogeneousMedium& medium = scene_.media()[size_t(segment.medium)];
     if (medium.isNonScattering()) return Rgb(0.0f);
@@ -21,8 +21,7 @@ Rgb SurfaceVplEstimator::contribution(const SurfaceVpl& vpl, const Rgb& flux, co
     const float r = std::sqrt(r2);
     const Vec3 w = toU / r;
     const SurfaceHit hit = surfaceHitOf(vpl);
-    const Bsdf& bsdf = scene_.shapes()[vpl.shape].bsdf;
-    const Rgb f = bsdf.eval(hit.shadingPoint(), -vpl.direction, w, TransportMode::Importance);
+    const Rgb f = atVpl.eval(w, TransportMode::Importance);
     if (isBlack(f)) return Rgb(0.0f);
     const float phase = medium.phase().eval(w, -segment.direction);
     if (!(phase > 0.0f)) return Rgb(0.0f);
@@ -40,10 +39,10 @@ Rgb SurfaceVplEstimator::contribution(const SurfaceVpl& vpl, const Rgb& flux, co
     return flux * f * between * medium.sigmaS() * medium.transmittance(us.t) * segment.throughputBefore * float(scale);
 }
 
-Rgb SurfaceVplEstimator::contribution(const SurfaceVpl& vpl, const Rgb& flux, const CameraPathSurface& x,
-                                      float radius) const {
-    if (!lambertianBounded(scene_.shapes()[x.hit.shape].bsdf)) return Rgb(0.0f);
-    const Bsdf& bsdf = scene_.shapes()[vpl.shape].bsdf;
+Rgb SurfaceVplEstimator::contribution(const SurfaceVpl& vpl, const PreparedBsdf& atVpl, const Rgb& flux,
+                                      const CameraPathSurface& x, float radius) const {
+    if (!lambertianBounded(scene_.shapes()[x.hit.shape].bsdf) || !reflectsBroadly(scene_.shapes()[vpl.shape].bsdf))
+        return Rgb(0.0f);
     const Vec3 toX = x.hit.position - vpl.position;
     const float r2 = toX.length2();
     if (!(r2 > 0.0f) || !std::isfinite(r2)) return Rgb(0.0f);
@@ -52,7 +51,7 @@ Rgb SurfaceVplEstimator::contribution(const SurfaceVpl& vpl, const Rgb& flux, co
     const Rgb fx = x.bsdf.eval(-w, TransportMode::Radiance);
     if (isBlack(fx)) return Rgb(0.0f);
     const SurfaceHit y = surfaceHitOf(vpl);
-    const Rgb fy = bsdf.eval(y.shadingPoint(), -vpl.direction, w, TransportMode::Importance);
+    const Rgb fy = atVpl.eval(w, TransportMode::Importance);
     if (isBlack(fy)) return Rgb(0.0f);
     // Visibility between offset origins at both ends; the stretches they skip lie in
     // the medium between, whose transmittance is taken over the whole distance r.

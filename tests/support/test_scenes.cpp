@@ -126,6 +126,24 @@ SceneDescription litRoomWithOccluder(const Rgb& sigmaS, const Rgb& sigmaA, float
     return scene;
 }
 
+SceneDescription roomWithGlossyReflectors(const Rgb& sigmaS, const Rgb& sigmaA, float g) {
+    SceneDescription scene = litRoomWithOccluder(sigmaS, sigmaA, g);
+    BsdfDescription narrow;
+    narrow.kind = BsdfDescription::Kind::RoughPlastic;
+    narrow.reflectance.value = Rgb(0.3f, 0.5f, 0.7f);
+    narrow.alphaU = narrow.alphaV = 0.1f;
+    scene.shapes[1].bsdf = narrow;  // the occluder
+    ShapeDescription panel;
+    panel.kind = ShapeDescription::Kind::Rectangle;
+    panel.toWorld = Transform::scale(Vec3(0.9f)).then(Transform::rotate(Vec3(0, 1, 0), -90.0f)).then(
+        Transform::translate(Vec3(1.95f, -0.9f, 0.9f)));  // +z rotated to -x: faces into the room
+    panel.bsdf = BsdfDescription{};
+    panel.bsdf->kind = BsdfDescription::Kind::RoughConductor;
+    panel.bsdf->alphaU = panel.bsdf->alphaV = 0.4f;
+    scene.shapes.push_back(panel);
+    return scene;
+}
+
 SceneDescription glassAndMirrorRoom(const Rgb& sigmaS, const Rgb& sigmaA, float g) {
     SceneDescription scene = litRoomWithOccluder(sigmaS, sigmaA, g);
     ShapeDescription glass;

@@ -49,6 +49,12 @@ SceneDescription mediumOnlyCube(const Rgb& sigmaS, const Rgb& sigmaA, float g);
 // rectangle under the ceiling facing down). Flat geometry only.
 SceneDescription litRoomWithOccluder(const Rgb& sigmaS, const Rgb& sigmaA, float g);
 
+// litRoomWithOccluder (diffuse walls) whose reflectors other than the walls are
+// glossy, one narrow and one broad for part (a)'s surface VPLs (reflectsBroadly):
+// a rough-plastic occluder (Beckmann alpha 0.1) and a rough-conductor panel on
+// the right wall (alpha 0.4), both lit by the spot light.
+SceneDescription roomWithGlossyReflectors(const Rgb& sigmaS, const Rgb& sigmaA, float g);
+
 // litRoomWithOccluder with a solid glass sphere (vacuum inside, the medium
 // outside) in front of the occluder and a copper mirror on the right wall:
 // camera paths reach the medium through glass and in the mirror.

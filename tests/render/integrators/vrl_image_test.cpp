@@ -237,6 +237,10 @@ TEST(VrlImage, SurfacePartWithSurfaceVplsEqualsPathTracedSurfacePart) {
     std::vector<std::pair<std::string, std::unique_ptr<Scene>>> scenes;
     for (const MediumCase& m : {kMedia[0], kMedia[2]})
         scenes.emplace_back(m.name, Scene::build(test::litRoomWithOccluder(m.sigmaS * 0.5f, m.sigmaA * 0.5f, m.g)));
+    // A narrow-lobe reflector whose light stays path-traced and a broad one whose VPLs take part.
+    scenes.emplace_back(std::string(kMedia[0].name) + ", glossy reflectors",
+                        Scene::build(test::roomWithGlossyReflectors(kMedia[0].sigmaS * 0.5f, kMedia[0].sigmaA * 0.5f,
+                                                                    kMedia[0].g)));
     const std::filesystem::path file = std::filesystem::path(VRL_SHARED_SCENES_DIR) / "lajolla-volpath-test/vol_cbox.xml";
     if (std::filesystem::exists(file)) {
         SceneDescription description = parseMitsubaScene(file);

@@ -486,6 +486,18 @@ TEST(BsdfTest, DegenerateInputsStayFinite) {
     }
 }
 
+// glossyRoughness: the smaller alpha of the glossy kinds (part (a) takes the surface
+// VPLs of lobes at least 0.25 wide, surface_vpl_estimator.h), 0 without a glossy lobe.
+TEST(BsdfTest, GlossyRoughnessIsTheSmallerAlphaOfGlossyLobes) {
+    for (Kind kind : {Kind::RoughPlastic, Kind::RoughConductor, Kind::RoughDielectric, Kind::Ward}) {
+        EXPECT_FLOAT_EQ(build(describe(kind, MicrofacetKind::Beckmann, 0.4f, 0.1f)).glossyRoughness(), 0.1f);
+        EXPECT_FLOAT_EQ(build(describe(kind, MicrofacetKind::GGX, 0.3f, 0.5f)).glossyRoughness(), 0.3f);
+    }
+    for (Kind kind : {Kind::Diffuse, Kind::Plastic, Kind::Conductor, Kind::Dielectric})
+        EXPECT_EQ(build(describe(kind, MicrofacetKind::Beckmann, 0.4f, 0.4f)).glossyRoughness(), 0.0f);
+    EXPECT_EQ(Bsdf::null().glossyRoughness(), 0.0f);
+}
+
 TEST(FresnelTest, DiffuseReflectanceMatchesQuadrature) {
     // Fdr(eta) = 2 * integral_0^1 F(mu) mu dmu by Simpson on the float Fresnel
     // (20000 intervals, error < 1e-5 even with the kink at the critical angle).
