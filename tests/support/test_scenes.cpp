@@ -126,6 +126,22 @@ SceneDescription litRoomWithOccluder(const Rgb& sigmaS, const Rgb& sigmaA, float
     return scene;
 }
 
+namespace {
+
+// A 0.9 x 0.9 rough-conductor (copper) panel on the room's right wall (x = 1.95), centred at height y.
+ShapeDescription roughMetalPanelOnRightWall(float y, float alpha) {
+    ShapeDescription panel;
+    panel.kind = ShapeDescription::Kind::Rectangle;
+    panel.toWorld = Transform::scale(Vec3(0.9f)).then(Transform::rotate(Vec3(0, 1, 0), -90.0f)).then(
+        Transform::translate(Vec3(1.95f, y, 0.9f)));  // +z rotated to -x: faces into the room
+    panel.bsdf = BsdfDescription{};
+    panel.bsdf->kind = BsdfDescription::Kind::RoughConductor;
+    panel.bsdf->alphaU = panel.bsdf->alphaV = alpha;
+    return panel;
+}
+
+}  // namespace
+
 SceneDescription roomWithGlossyReflectors(const Rgb& sigmaS, const Rgb& sigmaA, float g) {
     SceneDescription scene = litRoomWithOccluder(sigmaS, sigmaA, g);
     BsdfDescription narrow;
@@ -133,14 +149,7 @@ SceneDescription roomWithGlossyReflectors(const Rgb& sigmaS, const Rgb& sigmaA, 
     narrow.reflectance.value = Rgb(0.3f, 0.5f, 0.7f);
     narrow.alphaU = narrow.alphaV = 0.1f;
     scene.shapes[1].bsdf = narrow;  // the occluder
-    ShapeDescription panel;
-    panel.kind = ShapeDescription::Kind::Rectangle;
-    panel.toWorld = Transform::scale(Vec3(0.9f)).then(Transform::rotate(Vec3(0, 1, 0), -90.0f)).then(
-        Transform::translate(Vec3(1.95f, -0.9f, 0.9f)));  // +z rotated to -x: faces into the room
-    panel.bsdf = BsdfDescription{};
-    panel.bsdf->kind = BsdfDescription::Kind::RoughConductor;
-    panel.bsdf->alphaU = panel.bsdf->alphaV = 0.4f;
-    scene.shapes.push_back(panel);
+    scene.shapes.push_back(roughMetalPanelOnRightWall(-0.9f, 0.4f));
     return scene;
 }
 
@@ -190,14 +199,7 @@ SceneDescription glossyLitRoom(const Rgb& sigmaS, const Rgb& sigmaA, float g, co
     scene.shapes[1].bsdf = plastic;  // the occluder
     scene.shapes[2].toWorld = Transform::scale(Vec3(0.8f)).then(Transform::rotate(Vec3(1, 0, 0), 90.0f)).then(
         Transform::translate(Vec3(-0.8f, 1.95f, 0.8f)));  // a larger light: 1.6 x 1.6
-    ShapeDescription metal;
-    metal.kind = ShapeDescription::Kind::Rectangle;
-    metal.toWorld = Transform::scale(Vec3(0.9f)).then(Transform::rotate(Vec3(0, 1, 0), -90.0f)).then(
-        Transform::translate(Vec3(1.95f, -0.2f, 0.9f)));  // +z rotated to -x: faces into the room
-    metal.bsdf = BsdfDescription{};
-    metal.bsdf->kind = BsdfDescription::Kind::RoughConductor;
-    metal.bsdf->alphaU = metal.bsdf->alphaV = 0.05f;
-    scene.shapes.push_back(metal);
+    scene.shapes.push_back(roughMetalPanelOnRightWall(-0.2f, 0.05f));
     scene.media.push_back(medium("haze", sigmaS2, Rgb(0.0f), 0.0f));
     ShapeDescription haze;
     haze.kind = ShapeDescription::Kind::Cube;
