@@ -73,8 +73,8 @@ struct PathStart {
     // x2 reflects by a non-Dirac lobe, where x2 is reached from x1 by a non-Dirac
     // lobe and unscattered, x1's model Lambertian-bounded (lambertianBounded,
     // surface_vpl_estimator.h) and x2's reflecting broadly (reflectsBroadly: the
-    // VPLs on narrow lobes give part (a) nothing), to the VPLs, except for the share the VPLs' clamped
-    // 1 / max(d, R)^2 leaves out: with d = |x2 - x1|, x2's non-Dirac reflection (its
+    // VPLs on narrow lobes give part (a) nothing), to the VPLs, except for the
+    // share the VPLs' clamped 1 / max(d, R)^2 leaves out: with d = |x2 - x1|, x2's non-Dirac reflection (its
     // NEE and whatever follows a non-Dirac sample there) counts with weight
     // 1 - (d / R)^2 where d < R, and not at all beyond. Emission at x2 and its Dirac
     // lobes count in full. Since 1/d^2 = 1/max(d, R)^2 + (1/d^2 - 1/max(d, R)^2) and

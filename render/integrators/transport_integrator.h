@@ -17,7 +17,8 @@
 //       once per pixel: the sample's own x1 averages the pixel's footprint as the
 //       path tracer does (once per pixel, a pixel half on a lamp's bright inside
 //       came out either bright or dark). The path-traced part keeps x2's
-//       emission, its Dirac lobes and, for x2 within R of x1, the share the clamp
+//       emission, its Dirac lobes, the reflection of an x2 whose lobe is narrow
+//       (reflectsBroadly) and, for x2 within R of x1, the share the clamp
 //       leaves out (PathStart::surfaceVplRadius);
 //   (b) x1 in a medium, x2 not in a medium: single scattering from the lights
 //       (a point of the camera segment sampled equiangularly towards a light,

@@ -91,7 +91,7 @@ SurfaceVplLightcutsEstimator::SurfaceVplLightcutsEstimator(const Scene& scene, c
         const LightTreeNode& node = nodes[size_t(i)];
         if (node.isLeaf()) {
             const SurfaceVpl& vpl = lights.vpls[node.representative];
-            const bool lambertian = scene.shapes()[vpl.shape].bsdf.lambertianBound(vpl.uv).has_value();
+            const bool lambertian = lambertianBounded(scene.shapes()[vpl.shape].bsdf);
             normals_[size_t(i)] = NormalBound{vpl.geometricNormal, lambertian ? 0.0f : -1.0f};
             if (reflectsBroadly(scene.shapes()[vpl.shape].bsdf)) broadIntensity_[size_t(i)] = node.clusterFlux;
             continue;

@@ -68,8 +68,9 @@
 // x's shape bounding no medium, so the segment x-y stays inside it, else 1. Sum
 // over the representative's weighting as above: at most I_C c_y F_x T / max(d, R)^2.
 // Only the VPLs part (a) takes (reflectsBroadly) contribute; the others give 0, so
-// I_C there sums the I_k of those alone (0 for a node of narrow-lobe VPLs, never
-// drawn). The clamp makes every bound finite, even for a box that holds x. Part (a) takes
+// I_C there sums the I_k of those alone (0 for a node of narrow-lobe VPLs: such a
+// node is refined last, and a draw under it, which can happen only when it is in
+// the cut, gives 0). The clamp makes every bound finite, even for a box that holds x. Part (a) takes
 // this bound as the importance of a stochastic cut (sample, below): VPLs are drawn
 // in proportion to it, so a draw's estimate / probability stays near the node's
 // bound where visibility and the cosines are near their bounds.
@@ -139,7 +140,8 @@ public:
     // Lambertian-bounded): an unbiased estimate by a stochastic cut of `cutSize` nodes,
     // one VPL drawn under each (stochastic_cut.h). A node's importance is its point
     // bound above, summed over channels. With x's factor proven, it is 0 only where
-    // the node's flux is 0 or its box lies behind x, where every VPL below gives 0:
+    // the node's flux is 0, it holds no VPL part (a) takes (reflectsBroadly) or its
+    // box lies behind x, where every VPL below gives 0:
     // every VPL that can contribute is reachable. (On glossy VPLs the bound is a
     // heuristic; as an importance it only has to be positive, which it is.)
     Rgb sample(const CameraPathSurface& x, float radius, uint32_t cutSize, Rng& rng, CutStatistics& statistics) const;

@@ -55,7 +55,6 @@ inline bool lambertianBounded(const Bsdf& bsdf) {
     return bsdf.kind() == BsdfDescription::Kind::Diffuse || bsdf.kind() == BsdfDescription::Kind::Plastic;
 }
 
-// The VPL's vertex as the hit record the scene's functions take.
 // Part (a) takes a VPL's light (its point contribution, below) only where the VPL's
 // model reflects broadly: Lambertian-bounded, or a glossy lobe of roughness at least
 // kBroadLobeRoughness. A narrow lobe sends the VPL's light into a small cone, and the
@@ -70,6 +69,7 @@ inline bool reflectsBroadly(const Bsdf& bsdf) {
     return lambertianBounded(bsdf) || bsdf.glossyRoughness() >= kBroadLobeRoughness;
 }
 
+// The VPL's vertex as the hit record the scene's functions take.
 inline SurfaceHit surfaceHitOf(const SurfaceVpl& vpl) {
     SurfaceHit hit;
     hit.position = vpl.position;

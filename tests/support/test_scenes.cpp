@@ -128,7 +128,7 @@ SceneDescription litRoomWithOccluder(const Rgb& sigmaS, const Rgb& sigmaA, float
 
 namespace {
 
-// A 0.9 x 0.9 rough-conductor (copper) panel on the room's right wall (x = 1.95), centred at height y.
+// A 1.8 x 1.8 rough-conductor (copper) panel on the room's right wall (x = 1.95), centred at height y.
 ShapeDescription roughMetalPanelOnRightWall(float y, float alpha) {
     ShapeDescription panel;
     panel.kind = ShapeDescription::Kind::Rectangle;

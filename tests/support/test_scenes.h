@@ -52,7 +52,7 @@ SceneDescription litRoomWithOccluder(const Rgb& sigmaS, const Rgb& sigmaA, float
 // litRoomWithOccluder (diffuse walls) whose reflectors other than the walls are
 // glossy, one narrow and one broad for part (a)'s surface VPLs (reflectsBroadly):
 // a rough-plastic occluder (Beckmann alpha 0.1) and a rough-conductor panel on
-// the right wall (alpha 0.4), both lit by the spot light.
+// the right wall (alpha 0.4, 1.8 x 1.8), both lit by the spot light.
 SceneDescription roomWithGlossyReflectors(const Rgb& sigmaS, const Rgb& sigmaA, float g);
 
 // litRoomWithOccluder with a solid glass sphere (vacuum inside, the medium

@@ -3,6 +3,7 @@
 // MIS of NEE and BSDF sampling at surfaces against the NEE-only estimator.
 #include "render/integrators/path_tracer.h"
 #include "render/renderer.h"
+#include "render/vrl/surface_vpl_estimator.h"
 #include "tests/support/test_scenes.h"
 
 #include <gtest/gtest.h>
@@ -275,6 +276,60 @@ TEST(PathTracerMis, SameExpectationAsNeeOnlyInGlossyRoomWithMedia) {
                     << "restricted " << restricted << ", region " << r << " (0 = whole image), channel " << c;
             }
     }
+}
+
+// Part (a)'s split with surface VPLs (PathStart::surfaceVplRadius): the path tracer
+// weighs x2's non-Dirac reflection by max(0, 1 - d^2/R^2) only where x2's model
+// reflects broadly (reflectsBroadly), since the VPLs on narrow lobes give part (a)
+// nothing. In the lit room with narrow rough-plastic walls and light panel (alpha
+// 0.1) and a diffuse occluder (the only Lambertian x1; from it, every x2 is a wall
+// or the panel), R > 0 must leave every path as R = 0 traces it: the same bits, pixel
+// by pixel, 16 paths per pixel (without the guard, 35 of 256 pixels differ). With
+// diffuse walls instead (broad x2, and every x1 Lambertian), the same R changes
+// pixels (all 256). Part (a)'s restriction as the
+// integrator sets it: x1 reached by transmittance only, no medium vertex after x1.
+TEST(PathTracerSurfaceVplSplit, LeavesNarrowLobeX2WholeAndWeighsBroadX2) {
+    const auto trace = [](const Scene& scene, float radius) {
+        PathStart start;
+        start.firstSegmentTransmittanceOnly = true;
+        start.afterFirstSurface = PathStart::AfterFirstSurface::NotInMedium;
+        start.surfaceVplRadius = radius;
+        const VolumetricPathTracer tracer(scene, PathTracerSettings{});
+        const PerspectiveCamera& camera = scene.camera();
+        std::vector<Rgb> pixels;
+        for (int y = 0; y < camera.filmHeight(); ++y)
+            for (int x = 0; x < camera.filmWidth(); ++x) {
+                Rgb sum(0.0f);
+                for (uint64_t i = 0; i < 16; ++i) {
+                    Rng rng(53, Rng::combine(camera.filmPixelIndex(x, y), i));
+                    sum += tracer.radiance(camera.generateRay(x + 0.5f, y + 0.5f), scene.cameraMedium(), rng, start);
+                }
+                pixels.push_back(sum);
+            }
+        return pixels;
+    };
+    const auto differing = [](const std::vector<Rgb>& a, const std::vector<Rgb>& b) {
+        size_t count = 0;
+        for (size_t i = 0; i < a.size(); ++i) count += !(a[i].x == b[i].x && a[i].y == b[i].y && a[i].z == b[i].z);
+        return count;
+    };
+    SceneDescription narrowWalls = test::litRoomWithOccluder(Rgb(0.2f), Rgb(0.05f), 0.0f);
+    BsdfDescription narrow;
+    narrow.kind = BsdfDescription::Kind::RoughPlastic;
+    narrow.reflectance.value = Rgb(0.6f, 0.55f, 0.5f);
+    narrow.alphaU = narrow.alphaV = 0.1f;
+    narrow.twoSided = true;
+    narrowWalls.shapes[0].bsdf = narrow;  // the room
+    narrowWalls.shapes[2].bsdf = narrow;  // the light panel
+    const auto narrowScene = Scene::build(narrowWalls);
+    ASSERT_FALSE(reflectsBroadly(narrowScene->shapes()[0].bsdf));
+    ASSERT_TRUE(lambertianBounded(narrowScene->shapes()[1].bsdf));
+    const std::vector<Rgb> whole = trace(*narrowScene, 0.0f);
+    EXPECT_EQ(differing(whole, trace(*narrowScene, 0.5f)), 0u) << "narrow-lobe x2 must stay path-traced in full";
+    const auto diffuseScene = Scene::build(test::litRoomWithOccluder(Rgb(0.2f), Rgb(0.05f), 0.0f));
+    const size_t changed = differing(trace(*diffuseScene, 0.0f), trace(*diffuseScene, 0.5f));
+    std::printf("broad x2: %zu of %zu pixels changed by R = 0.5\n", changed, whole.size());
+    EXPECT_GT(changed, 10u) << "a broad x2 within R must be weighted";
 }
 
 // The point of MIS: on a glossy surface (Beckmann alpha 0.05) lit by an area light,

@@ -218,8 +218,9 @@ TEST(VrlImage, PartsSumToReferenceInLitRoomWithOccluder) {
 // Part (a) alone with vrl-lightcuts, its light from non-Dirac reflections at x2
 // sampled from the surface VPLs per camera sample (the inverse square clamped,
 // path tracing adding the rest within R), equals part (a) path-traced alone
-// (--surface-vpls 0): the split is unbiased. The lit room (grey and HG media)
-// and the shared Cornell box.
+// (--surface-vpls 0): the split is unbiased. The lit room (grey and HG media),
+// the room with a narrow-lobe (alpha 0.1: path-traced) and a broad (alpha 0.4:
+// from its VPLs) glossy reflector, and the shared Cornell box.
 RunStatistics surfacePartRuns(const Scene& scene, uint64_t surfaceVplLimit) {
     return overRuns([&](uint64_t seed) {
         RenderSettings settings;

@@ -52,12 +52,12 @@
 #include <gtest/gtest.h>
 
 #include <array>
-#include <utility>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <limits>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace vrl {
@@ -620,6 +620,7 @@ TEST(SurfaceVplCut, PointSamplesReachEveryLitVplAndAreUnbiased) {
         const SurfaceVplLightcutsEstimator cut(scene, setup.lights, estimator, CutSettings{});
         double worstZ = 0.0;
         uint64_t litVpls = 0, litBroadGlossy = 0, narrowVpls = 0;
+        for (const SurfaceVpl& vpl : setup.lights.vpls) narrowVpls += !reflectsBroadly(scene.shapes()[vpl.shape].bsdf);
         for (size_t j = 0; j < points.size(); ++j) {
             const CameraPathSurface& x = points[j];
             const std::vector<double> p = stochasticLeafProbabilities(
@@ -629,11 +630,11 @@ TEST(SurfaceVplCut, PointSamplesReachEveryLitVplAndAreUnbiased) {
                 total += p[k];
                 const SurfaceVpl& vpl = setup.lights.vpls[k];
                 const Bsdf& atVpl = scene.shapes()[vpl.shape].bsdf;
-                if (!reflectsBroadly(atVpl)) {  // its bound is 0: drawn only below a node whose importance is 0
-                    ++narrowVpls;
-                    EXPECT_TRUE(isBlack(estimator.contribution(vpl, vpl.flux, x, radius)))
-                        << name << " point " << j << ": VPL " << k << " on a narrow lobe gives light";
-                }
+                // A narrow-lobe VPL's leaf (leaf k is VPL k) has bound, so importance, 0: it is
+                // drawn only under a node of importance 0 in the cut, and gives 0 there.
+                if (!reflectsBroadly(atVpl))
+                    EXPECT_TRUE(isBlack(cut.bound(int32_t(k), x, radius)))
+                        << name << " point " << j << ": VPL " << k << " on a narrow lobe has a non-zero bound";
                 if (maxComponent(estimator.contribution(vpl, vpl.flux, x, radius)) > 0.0f) {
                     ++litVpls;
                     litBroadGlossy += !lambertianBounded(atVpl);
@@ -645,8 +646,11 @@ TEST(SurfaceVplCut, PointSamplesReachEveryLitVplAndAreUnbiased) {
             const Rgb plain = sumOverSurfaceVpls(estimator, setup.lights.vpls, x, radius);
             double sum = 0.0, sum2 = 0.0;
             // The glossy room's estimates are heavier-tailed (a broad lobe's node bound is a
-            // heuristic importance, so a rare draw weighs much): its sample standard error
-            // settles only with more samples (largest |z| 4.25 at 1,500, 3.87 at 12,000).
+            // heuristic importance, so a rare draw weighs much), and the sample standard
+            // error of a heavy-tailed mean underestimates the true one, so the normal
+            // P = 7e-6 does not hold there: more samples let it settle (largest |z| 4.25
+            // at 1,500, 4.46 at 3,000, 3.87 at 12,000; a bias would grow |z| with the
+            // square root of the count). Fixed seeds: a regression check at this size.
             const int kSamples = glossy ? 12000 : 1500;
             for (int i = 0; i < kSamples; ++i) {
                 Rng rng(1000 + j, uint64_t(i));
@@ -662,13 +666,13 @@ TEST(SurfaceVplCut, PointSamplesReachEveryLitVplAndAreUnbiased) {
             EXPECT_NEAR(mean, expected, 4.5 * se + 1e-12 * expected) << name << " point " << j;
         }
         std::printf("%s: %zu points, %zu VPLs, %llu lit (point, VPL) pairs all reachable (%llu on the broad glossy "
-                    "panel), %llu (point, narrow-lobe VPL) pairs giving 0, largest |z| %.2f\n",
+                    "panel), %llu narrow-lobe VPLs with bound 0 at every point, largest |z| %.2f\n",
                     name.c_str(), points.size(), setup.lights.vpls.size(), (unsigned long long)litVpls,
                     (unsigned long long)litBroadGlossy, (unsigned long long)narrowVpls, worstZ);
         EXPECT_GT(litVpls, 1000u);
         if (glossy) {
             EXPECT_GT(litBroadGlossy, 100u) << name << ": the broad panel's VPLs take part";
-            EXPECT_GT(narrowVpls, 100u) << name << ": the occluder leaves narrow-lobe VPLs";
+            EXPECT_GT(narrowVpls, 50u) << name << ": the occluder leaves narrow-lobe VPLs";
         }
     }
 }
