@@ -142,13 +142,18 @@ ShapeDescription roughMetalPanelOnRightWall(float y, float alpha) {
 
 }  // namespace
 
+BsdfDescription roughPlastic(const Rgb& reflectance, float alpha, bool twoSided) {
+    BsdfDescription bsdf;
+    bsdf.kind = BsdfDescription::Kind::RoughPlastic;
+    bsdf.reflectance.value = reflectance;
+    bsdf.alphaU = bsdf.alphaV = alpha;
+    bsdf.twoSided = twoSided;
+    return bsdf;
+}
+
 SceneDescription roomWithGlossyReflectors(const Rgb& sigmaS, const Rgb& sigmaA, float g) {
     SceneDescription scene = litRoomWithOccluder(sigmaS, sigmaA, g);
-    BsdfDescription narrow;
-    narrow.kind = BsdfDescription::Kind::RoughPlastic;
-    narrow.reflectance.value = Rgb(0.3f, 0.5f, 0.7f);
-    narrow.alphaU = narrow.alphaV = 0.1f;
-    scene.shapes[1].bsdf = narrow;  // the occluder
+    scene.shapes[1].bsdf = roughPlastic(Rgb(0.3f, 0.5f, 0.7f), 0.1f, false);  // the occluder
     scene.shapes.push_back(roughMetalPanelOnRightWall(-0.9f, 0.4f));
     return scene;
 }
@@ -187,12 +192,7 @@ SceneDescription withoutAreaLights(SceneDescription scene) {
 
 SceneDescription glossyLitRoom(const Rgb& sigmaS, const Rgb& sigmaA, float g, const Rgb& sigmaS2) {
     SceneDescription scene = litRoomWithOccluder(sigmaS, sigmaA, g);
-    BsdfDescription roughPlastic;
-    roughPlastic.kind = BsdfDescription::Kind::RoughPlastic;
-    roughPlastic.reflectance.value = Rgb(0.6f, 0.55f, 0.5f);
-    roughPlastic.alphaU = roughPlastic.alphaV = 0.1f;
-    roughPlastic.twoSided = true;
-    scene.shapes[0].bsdf = roughPlastic;  // the room
+    scene.shapes[0].bsdf = roughPlastic(Rgb(0.6f, 0.55f, 0.5f), 0.1f, true);  // the room
     BsdfDescription plastic;
     plastic.kind = BsdfDescription::Kind::Plastic;
     plastic.reflectance.value = Rgb(0.3f, 0.5f, 0.7f);

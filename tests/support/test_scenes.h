@@ -49,6 +49,9 @@ SceneDescription mediumOnlyCube(const Rgb& sigmaS, const Rgb& sigmaA, float g);
 // rectangle under the ceiling facing down). Flat geometry only.
 SceneDescription litRoomWithOccluder(const Rgb& sigmaS, const Rgb& sigmaA, float g);
 
+// Mitsuba's roughplastic (Beckmann) with the given diffuse reflectance and alpha.
+BsdfDescription roughPlastic(const Rgb& reflectance, float alpha, bool twoSided);
+
 // litRoomWithOccluder (diffuse walls) whose reflectors other than the walls are
 // glossy, one narrow and one broad for part (a)'s surface VPLs (reflectsBroadly):
 // a rough-plastic occluder (Beckmann alpha 0.1) and a rough-conductor panel on

@@ -314,11 +314,7 @@ TEST(PathTracerSurfaceVplSplit, LeavesNarrowLobeX2WholeAndWeighsBroadX2) {
         return count;
     };
     SceneDescription narrowWalls = test::litRoomWithOccluder(Rgb(0.2f), Rgb(0.05f), 0.0f);
-    BsdfDescription narrow;
-    narrow.kind = BsdfDescription::Kind::RoughPlastic;
-    narrow.reflectance.value = Rgb(0.6f, 0.55f, 0.5f);
-    narrow.alphaU = narrow.alphaV = 0.1f;
-    narrow.twoSided = true;
+    const BsdfDescription narrow = test::roughPlastic(Rgb(0.6f, 0.55f, 0.5f), 0.1f, true);
     narrowWalls.shapes[0].bsdf = narrow;  // the room
     narrowWalls.shapes[2].bsdf = narrow;  // the light panel
     const auto narrowScene = Scene::build(narrowWalls);

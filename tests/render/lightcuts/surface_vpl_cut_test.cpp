@@ -632,9 +632,10 @@ TEST(SurfaceVplCut, PointSamplesReachEveryLitVplAndAreUnbiased) {
                 const Bsdf& atVpl = scene.shapes()[vpl.shape].bsdf;
                 // A narrow-lobe VPL's leaf (leaf k is VPL k) has bound, so importance, 0: it is
                 // drawn only under a node of importance 0 in the cut, and gives 0 there.
-                if (!reflectsBroadly(atVpl))
+                if (!reflectsBroadly(atVpl)) {
                     EXPECT_TRUE(isBlack(cut.bound(int32_t(k), x, radius)))
                         << name << " point " << j << ": VPL " << k << " on a narrow lobe has a non-zero bound";
+                }
                 if (maxComponent(estimator.contribution(vpl, vpl.flux, x, radius)) > 0.0f) {
                     ++litVpls;
                     litBroadGlossy += !lambertianBounded(atVpl);
