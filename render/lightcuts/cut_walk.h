@@ -34,6 +34,19 @@
 // A crossed node (refined without an estimate) that shares its parent's
 // representative passes the inherited estimate on to its children, so a walk to
 // the leaves evaluates every VRL exactly once.
+//
+// Deferred bounds. A visitor whose bound has an expensive factor may offer
+//   bool bound(int32_t node, const Rgb* inherited, Rgb& bound, Rgb& factor, bool& tight)
+// instead of bound(node, bound): with `inherited` (the factor its parent's tight bound
+// used; null for the root and below crossed nodes that had none) it may return a
+// cheap bound built on that factor (tight = false); without, or where the factor is
+// cheap anyway, the full one (tight = true), and in both cases the factor it used.
+// The walk makes a node's bound tight only when that node reaches the top of the heap
+// above the threshold, that is, only before it would be refined: nodes that stay in
+// the cut below the threshold on their cheap bound never pay for the full one.
+// Where the cheap bound is at least the tight one the cut is the same as with tight
+// bounds everywhere; where it is not (a heuristic factor), the cut relies on the
+// cheap bound, and boundExceeded counts each node against the bound it last had.
 #pragma once
 
 #include "render/core/rgb.h"
@@ -41,6 +54,7 @@
 #include "render/lightcuts/light_tree.h"
 
 #include <algorithm>
+#include <concepts>
 #include <limits>
 #include <vector>
 
@@ -53,6 +67,9 @@ struct CutScratch {
         float bound;  // luminance of the node's bound
         int32_t node;
         Rgb estimate;
+        Rgb factor{0.0f};   // deferred bounds: the factor the bound used (passed to the children)
+        bool tight = true;  // deferred bounds: false while the bound is the cheap one
+        bool exceeded = false;  // the estimate exceeds the bound (counted in CutStatistics::boundExceeded)
         bool operator<(const CutNode& o) const { return bound != o.bound ? bound < o.bound : node > o.node; }
     };
     std::vector<CutNode> heap;      // a max-heap (std::push_heap) on bound
@@ -61,12 +78,19 @@ struct CutScratch {
         int32_t parent;  // the parent whose estimate it may inherit; -1: none (the root, the children
                          // of a crossed node that did not share its own parent's representative)
         Rgb parentEstimate;
+        Rgb factor{0.0f};          // deferred bounds: the parent's factor
+        bool hasFactor = false;
     };
     std::vector<Pending> pending;   // nodes to add to the cut (children of refined nodes)
     std::vector<CutNode> added;     // nodes with an estimate, to push on the heap
     std::vector<int32_t> queued;    // nodes to estimate, in one batch
     std::vector<Rgb> bounds, estimates;  // of the queued nodes
     std::vector<Rgb> addedBounds;       // of the added (inherited) nodes
+    struct Deferred {
+        Rgb factor;
+        bool tight;
+    };
+    std::vector<Deferred> deferred, addedDeferred;  // deferred bounds: of the queued and the added nodes
     bool inUse = false;
 };
 
@@ -99,6 +123,9 @@ Rgb walkCut(const LightTree& tree, const CutSettings& settings, CutStatistics& s
     auto& queued = scratch.queued;
     auto& added = scratch.added;
     heap.clear(), pending.clear(), queued.clear(), scratch.bounds.clear();
+    constexpr bool kDeferred = requires(Rgb& r, bool& t, const Rgb* f) {
+        { visitor.bound(int32_t(0), f, r, r, t) } -> std::convertible_to<bool>;
+    };
     Rgb total(0.0f);
     uint32_t leavesInCut = 0;
     const auto& nodes = tree.nodes();
@@ -112,8 +139,13 @@ Rgb walkCut(const LightTree& tree, const CutSettings& settings, CutStatistics& s
         return Rgb(from.x > 0.0f ? e.x * (to.x / from.x) : 0.0f, from.y > 0.0f ? e.y * (to.y / from.y) : 0.0f,
                    from.z > 0.0f ? e.z * (to.z / from.z) : 0.0f);
     };
+    const auto exceeds = [](const Rgb& e, const Rgb& b) { return e.x > b.x || e.y > b.y || e.z > b.z; };
+    const auto heapKey = [](const Rgb& b) {
+        const float key = luminance(b);
+        return key >= 0.0f ? key : std::numeric_limits<float>::infinity();  // NaN: refine
+    };
     // Adds a node with its estimate and bound to the cut.
-    const auto addToCut = [&](int32_t i, const Rgb& e, const Rgb& b) {
+    const auto addToCut = [&](int32_t i, const Rgb& e, const Rgb& b, const CutScratch::Deferred& d) {
         total += e;
         ++statistics.evaluated;
         if (nodes[i].isLeaf()) {
@@ -121,37 +153,49 @@ Rgb walkCut(const LightTree& tree, const CutSettings& settings, CutStatistics& s
             return;
         }
         ++statistics.boundedEstimates;
-        if (e.x > b.x || e.y > b.y || e.z > b.z) ++statistics.boundExceeded;
-        const float key = luminance(b);
-        heap.push_back({key >= 0.0f ? key : std::numeric_limits<float>::infinity(), i, e});  // NaN: refine
+        const bool exceeded = exceeds(e, b);
+        if (exceeded) ++statistics.boundExceeded;
+        heap.push_back({heapKey(b), i, e, d.factor, d.tight, exceeded});
         std::push_heap(heap.begin(), heap.end());
     };
     // Adds the nodes in `pending` (and, for crossed nodes, their children) to the cut.
     const auto addPending = [&] {
         queued.clear(), scratch.bounds.clear(), added.clear(), scratch.addedBounds.clear();
+        scratch.deferred.clear(), scratch.addedDeferred.clear();
         while (!pending.empty()) {
             const CutScratch::Pending p = pending.back();
             pending.pop_back();
             const int32_t i = p.node;
             const LightTreeNode& node = nodes[i];
             Rgb b(0.0f);
+            CutScratch::Deferred d{Rgb(0.0f), true};
+            bool crossed = false;
+            if (!node.isLeaf()) {
+                if constexpr (kDeferred)
+                    crossed = !visitor.bound(i, p.hasFactor ? &p.factor : nullptr, b, d.factor, d.tight);
+                else
+                    crossed = !visitor.bound(i, b);
+            }
             const bool shares = p.parent >= 0 && node.representative == nodes[p.parent].representative;
-            if (!node.isLeaf() && !visitor.bound(i, b)) {  // infinite bound: refine without estimating
+            if (crossed) {  // infinite bound: refine without estimating
                 ++statistics.intersected;
                 // Its estimate, had it been made, is known when it shares the parent's
-                // representative: its children may inherit from it.
+                // representative: its children may inherit from it. Its children get the
+                // factor it was given (their boxes lie in its parent's).
                 const Rgb e = shares ? inherit(p.parentEstimate, p.parent, i) : Rgb(0.0f);
-                pending.push_back({node.left, shares ? i : -1, e});
-                pending.push_back({node.right, shares ? i : -1, e});
+                pending.push_back({node.left, shares ? i : -1, e, p.factor, p.hasFactor});
+                pending.push_back({node.right, shares ? i : -1, e, p.factor, p.hasFactor});
                 continue;
             }
             if (shares) {
                 added.push_back({0.0f, i, inherit(p.parentEstimate, p.parent, i)});
                 scratch.addedBounds.push_back(b);
+                scratch.addedDeferred.push_back(d);
                 continue;
             }
             queued.push_back(i);
             scratch.bounds.push_back(b);
+            scratch.deferred.push_back(d);
         }
         scratch.estimates.resize(queued.size());
         if constexpr (requires { visitor.evaluate(queued.data(), scratch.estimates.data(), queued.size()); }) {
@@ -160,23 +204,43 @@ Rgb walkCut(const LightTree& tree, const CutSettings& settings, CutStatistics& s
             for (size_t k = 0; k < queued.size(); ++k)
                 scratch.estimates[k] = nodes[queued[k]].isLeaf() ? visitor.leaf(queued[k]) : visitor.estimate(queued[k]);
         }
-        for (size_t a = 0; a < added.size(); ++a) addToCut(added[a].node, added[a].estimate, scratch.addedBounds[a]);
-        for (size_t q = 0; q < queued.size(); ++q) addToCut(queued[q], scratch.estimates[q], scratch.bounds[q]);
+        for (size_t a = 0; a < added.size(); ++a)
+            addToCut(added[a].node, added[a].estimate, scratch.addedBounds[a], scratch.addedDeferred[a]);
+        for (size_t q = 0; q < queued.size(); ++q)
+            addToCut(queued[q], scratch.estimates[q], scratch.bounds[q], scratch.deferred[q]);
     };
     pending.push_back({tree.root(), -1, Rgb(0.0f)});
     addPending();
     while (!heap.empty()) {
         const float threshold = settings.errorThreshold * (std::max(0.0f, luminance(total)) + otherLuminance);
-        for (int refined = 0; refined < kRefineBatch && !heap.empty(); ++refined) {
-            const CutScratch::CutNode top = heap.front();
+        for (int refined = 0; refined < kRefineBatch && !heap.empty();) {
+            CutScratch::CutNode top = heap.front();
             if (top.bound <= threshold) break;
             // The cut's size after `refined` refinements of this batch (each adds one node).
             if (heap.size() + leavesInCut + 2 * size_t(refined) >= settings.maxCutSize) break;
             std::pop_heap(heap.begin(), heap.end());
             heap.pop_back();
+            if constexpr (kDeferred) {
+                if (!top.tight) {  // above the threshold on its cheap bound: make it tight, and look again
+                    Rgb b(0.0f);
+                    visitor.bound(top.node, nullptr, b, top.factor, top.tight);  // not crossed: its distance is known
+                    top.tight = true;
+                    const bool nowExceeded = exceeds(top.estimate, b);
+                    if (nowExceeded != top.exceeded) {  // count the node against the bound it now has
+                        if (nowExceeded) ++statistics.boundExceeded;
+                        else --statistics.boundExceeded;
+                    }
+                    top.exceeded = nowExceeded;
+                    top.bound = heapKey(b);
+                    heap.push_back(top);
+                    std::push_heap(heap.begin(), heap.end());
+                    continue;
+                }
+            }
             total -= top.estimate;
-            pending.push_back({nodes[top.node].right, top.node, top.estimate});
-            pending.push_back({nodes[top.node].left, top.node, top.estimate});
+            pending.push_back({nodes[top.node].right, top.node, top.estimate, top.factor, kDeferred});
+            pending.push_back({nodes[top.node].left, top.node, top.estimate, top.factor, kDeferred});
+            ++refined;
         }
         if (pending.empty()) break;
         addPending();

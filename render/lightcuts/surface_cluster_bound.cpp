@@ -83,7 +83,8 @@ double SurfaceClusterBound::minimumDistance(int32_t index, const Vec3& x) const 
 }
 
 Rgb SurfaceClusterBound::reflectionTowardsBox(const CameraPathSurface& x, const Bsdf& bsdf, const Imath::Box3f& box,
-                                              double d, double slack, float glossyMargin) {
+                                              double d, double slack, float glossyMargin,
+                                              const Rgb* inheritedGlossy) {
     const Vec3& p = x.hit.position;
     // Reflection only on wo's geometric side: a box wholly behind gives nothing.
     const bool reflectsOnly = bsdf.kind() != BsdfDescription::Kind::RoughDielectric;
@@ -96,6 +97,8 @@ Rgb SurfaceClusterBound::reflectionTowardsBox(const CameraPathSurface& x, const 
         const auto [lo, hi] = signedDistanceRange(box, x.hit.shadingNormal, p);
         const double cosine = std::min(1.0, (std::max(std::abs(lo), std::abs(hi)) + slack) / d);
         fCos = *lambert * float(cosine);
+    } else if (inheritedGlossy) {
+        fCos = *inheritedGlossy;
     } else {
         // Glossy: the largest f|cos| towards the box's corners, its centre and its
         // point nearest the mirror direction (where a lobe peaks), with a margin (a heuristic).
@@ -125,6 +128,11 @@ Rgb SurfaceClusterBound::reflectionTowardsBox(const CameraPathSurface& x, const 
 }
 
 Rgb SurfaceClusterBound::bound(int32_t index, const CameraPathSurface& x, bool* xInsideNode) const {
+    return bound(index, x, xInsideNode, nullptr, nullptr, nullptr);
+}
+
+Rgb SurfaceClusterBound::bound(int32_t index, const CameraPathSurface& x, bool* xInsideNode,
+                               const Rgb* inheritedGlossy, Rgb* factor, bool* tight) const {
     const LightTreeNode& node = tree_.nodes()[index];
     const Vec3& p = x.hit.position;
     const float reach = std::max({std::abs(node.box.min.x), std::abs(node.box.min.y), std::abs(node.box.min.z),
@@ -136,7 +144,9 @@ Rgb SurfaceClusterBound::bound(int32_t index, const CameraPathSurface& x, bool* 
 
     const SceneShape& shape = scene_.shapes()[x.hit.shape];
     const bool reflectsOnly = shape.bsdf.kind() != BsdfDescription::Kind::RoughDielectric;
-    const Rgb fCos = reflectionTowardsBox(x, shape.bsdf, node.box, d, slack, settings_.glossyMargin);
+    const Rgb fCos = reflectionTowardsBox(x, shape.bsdf, node.box, d, slack, settings_.glossyMargin, inheritedGlossy);
+    if (factor) *factor = fCos;
+    if (tight) *tight = !inheritedGlossy || x.bsdf.lambertianBound().has_value();
     if (isBlack(fCos)) return Rgb(0.0f);
 
     const HomogeneousMedium* vrlMedium = node.medium >= 0 ? &scene_.media()[node.medium] : nullptr;

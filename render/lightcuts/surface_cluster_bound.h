@@ -63,6 +63,13 @@ public:
     // RGB bound for `node` lighting `x`; +infinity (and *xInsideNode = true) when
     // x lies in the node's box (or on one of a small node's segments).
     Rgb bound(int32_t node, const CameraPathSurface& x, bool* xInsideNode = nullptr) const;
+    // The same with the receiver's factor (f_s|cos| above) returned in *factor. For a
+    // glossy x, a given `inheritedGlossy` (the factor of a box holding this node's box,
+    // its parent's) replaces the 10 BSDF evaluations: a cheaper heuristic, since the
+    // directions to the node are among those to the parent box (deferred bounds,
+    // cut_walk.h); *tight says whether the full bound was computed.
+    Rgb bound(int32_t node, const CameraPathSurface& x, bool* xInsideNode, const Rgb* inheritedGlossy, Rgb* factor,
+              bool* tight) const;
     // The distance from x to the node used by the bound (box, or exact for small nodes).
     double minimumDistance(int32_t node, const Vec3& x) const;
     // Whether the bound is proven for the BSDF at x (diffuse) or a heuristic (glossy).
@@ -73,8 +80,9 @@ public:
     // (`slack`: the rounding margin of the caller's distances). 0 where the whole
     // box lies behind a reflecting x; Lambertian: proven, glossy: the heuristic
     // above with `glossyMargin`.
+    // `inheritedGlossy`: for a glossy x, the factor to use instead of evaluating the BSDF.
     static Rgb reflectionTowardsBox(const CameraPathSurface& x, const Bsdf& bsdf, const Imath::Box3f& box, double d,
-                                    double slack, float glossyMargin);
+                                    double slack, float glossyMargin, const Rgb* inheritedGlossy = nullptr);
 
 private:
     // The bound on f_p (see above) for the node's VRLs lighting x at distance >= d.

@@ -22,9 +22,9 @@ Rgb SurfaceLightcutsEstimator::estimate(const CameraPathSurface& x, uint64_t str
             Rng rng = vrlStream(streamKey, k);
             return self.estimator_.contribution(self.tree_.vrls()[k], x, rng);
         }
-        bool bound(int32_t i, Rgb& b) const {
+        bool bound(int32_t i, const Rgb* inherited, Rgb& b, Rgb& factor, bool& tight) const {
             bool inside = false;
-            b = self.bound_.bound(i, x, &inside);
+            b = self.bound_.bound(i, x, &inside, inherited, &factor, &tight);
             return !inside;
         }
         Rgb estimate(int32_t i) const {

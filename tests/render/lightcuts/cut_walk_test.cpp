@@ -11,7 +11,12 @@
 // * batched refinement against a sequential reference walk written here (one
 //   node at a time, every node evaluated): refinements share evaluate() calls,
 //   the same result within the cut's own error (tolerances below);
-// * maxCutSize caps the cut exactly.
+// * maxCutSize caps the cut exactly;
+// * deferred bounds (a cheap bound from the parent's factor, made tight only
+//   before a refinement): where the cheap bound is at least the tight one, the
+//   same cut, bits and statistics as tight bounds everywhere (bound violations:
+//   at most as many, each node checked against the bound it last had), with fewer
+//   tight bounds computed.
 #include "render/core/rng.h"
 #include "render/lightcuts/cut_walk.h"
 #include "render/lightcuts/light_tree.h"
@@ -58,9 +63,11 @@ Rgb nodeFlux(const LightTree& tree, int32_t i) {
 // node's size, so that the walk refines big nodes first; `crossEvery` > 0 makes
 // every such inner node (by index) a crossed one.
 struct Synthetic {
-    explicit Synthetic(const LightTree& t, int cross = 0) : tree(t), crossEvery(cross) {}
+    explicit Synthetic(const LightTree& t, int cross = 0, float scale = 1.5f)
+        : tree(t), crossEvery(cross), boundScale(scale) {}
     const LightTree& tree;
     int crossEvery = 0;
+    float boundScale = 1.5f;  // below 1.5, some estimates exceed their bound
     mutable std::vector<int32_t> evaluatedNodes;
     Rgb leaf(int32_t i) const { return estimate(i); }
     Rgb estimate(int32_t i) const {
@@ -70,7 +77,24 @@ struct Synthetic {
     bool bound(int32_t i, Rgb& b) const {
         const LightTreeNode& n = tree.nodes()[size_t(i)];
         if (crossEvery > 0 && i % crossEvery == 0) return false;
-        b = n.clusterFlux * (1.5f * float(n.vrlCount));
+        b = n.clusterFlux * (boundScale * float(n.vrlCount));
+        return true;
+    }
+};
+
+// The same bound as a factor (boundScale x vrlCount, which shrinks down the tree)
+// times the flux; given the parent's factor, the cheap bound uses it instead: at
+// least the tight one, since a parent holds more VRLs.
+struct SyntheticDeferred : Synthetic {
+    using Synthetic::Synthetic;
+    mutable size_t tightBounds = 0, cheapBounds = 0;
+    bool bound(int32_t i, const Rgb* inherited, Rgb& b, Rgb& factor, bool& tight) const {
+        const LightTreeNode& n = tree.nodes()[size_t(i)];
+        if (crossEvery > 0 && i % crossEvery == 0) return false;
+        tight = inherited == nullptr;
+        factor = inherited ? *inherited : Rgb(boundScale * float(n.vrlCount));
+        ++(tight ? tightBounds : cheapBounds);
+        b = n.clusterFlux * factor;
         return true;
     }
 };
@@ -224,6 +248,51 @@ TEST(CutWalk, MaxCutSizeCapsTheCut) {
         walkCut(tree, settings, stats, v);
         EXPECT_EQ(stats.cutSize, std::max(cap, 1u)) << cap;
     }
+}
+
+// Deferred bounds whose cheap bound is at least the tight one: the walk refines
+// the same nodes in the same order (a cheap node on top is made tight before it can
+// be refined, and the threshold test only stops on a bound that is at least the
+// tight one), so totals, evaluated nodes and statistics are bit for bit those of
+// tight bounds everywhere (boundScale 0.6 makes bound violations, counted against
+// the bound each node last had); and nodes left in the cut below the threshold
+// never get a tight bound.
+TEST(CutWalk, DeferredBoundsKeepTheCutAndSkipTightBoundsOfNodesNotRefined) {
+    const LightTree tree = LightTree::build(randomVrls(3000, 6));
+    for (const int cross : {0, 13})
+        for (const float scale : {1.5f, 0.6f})
+            for (const float threshold : {0.0f, 0.002f, 0.02f, 0.2f}) {
+                SCOPED_TRACE(testing::Message() << "cross " << cross << " scale " << scale << " e " << threshold);
+                Synthetic tightEverywhere{tree, cross, scale};
+                SyntheticDeferred deferred{tree, cross, scale};
+                CutStatistics st, sd;
+                const Rgb tt = walkCut(tree, settingsFor(threshold), st, tightEverywhere);
+                const Rgb td = walkCut(tree, settingsFor(threshold), sd, deferred);
+                EXPECT_EQ(tt.x, td.x);
+                EXPECT_EQ(tt.y, td.y);
+                EXPECT_EQ(tt.z, td.z);
+                EXPECT_EQ(tightEverywhere.evaluatedNodes, deferred.evaluatedNodes);
+                EXPECT_EQ(st.evaluated, sd.evaluated);
+                EXPECT_EQ(st.cutSize, sd.cutSize);
+                EXPECT_EQ(st.intersected, sd.intersected);
+                EXPECT_EQ(st.boundedEstimates, sd.boundedEstimates);
+                // Violations count against the bound each node last had: a node never made
+                // tight is checked against its cheap bound (here larger), so at most as many.
+                EXPECT_LE(sd.boundExceeded, st.boundExceeded);
+                if (scale < 1.0f && threshold < 0.1f) {
+                    EXPECT_GT(sd.boundExceeded, 0u);
+                }
+                if (scale >= 1.5f) {
+                    EXPECT_EQ(st.boundExceeded, 0u);
+                }
+                // Every refined node was made tight first; a cut stopped by the threshold
+                // leaves nodes that never were.
+                const uint32_t refinements = (st.evaluated + st.intersected - 1) / 2;
+                EXPECT_GE(deferred.tightBounds, size_t(refinements) - st.intersected);
+                if (threshold >= 0.02f) {
+                    EXPECT_LT(deferred.tightBounds, size_t(st.boundedEstimates));
+                }
+            }
 }
 
 }  // namespace
