@@ -35,12 +35,14 @@
 // representative passes the inherited estimate on to its children, so a walk to
 // the leaves evaluates every VRL exactly once.
 //
-// Deferred bounds. A visitor whose bound has an expensive factor may offer
+// Deferred bounds. A visitor whose bound has expensive parts may offer
 //   bool bound(int32_t node, const Rgb* inherited, Rgb& bound, Rgb& factor, bool& tight)
-// instead of bound(node, bound): with `inherited` (the factor its parent's tight bound
-// used; null for the root and below crossed nodes that had none) it may return a
-// cheap bound built on that factor (tight = false); without, or where the factor is
-// cheap anyway, the full one (tight = true), and in both cases the factor it used.
+//   void tighten(int32_t node, Rgb& bound, Rgb& factor)
+// instead of bound(node, bound). The first may return a cheap bound (tight = false),
+// built for instance on `inherited`, the factor its parent's tight bound used (null
+// for the root and below crossed nodes that had none); it decides whether the query
+// crosses the node exactly, as bound(node, bound) does. tighten gives the full bound
+// of a node that is not crossed. Both return the factor they used.
 // The walk makes a node's bound tight only when that node reaches the top of the heap
 // above the threshold, that is, only before it would be refined: nodes that stay in
 // the cut below the threshold on their cheap bound never pay for the full one.
@@ -56,20 +58,34 @@
 #include <algorithm>
 #include <concepts>
 #include <limits>
+#include <type_traits>
 #include <vector>
 
 namespace vrl {
 
-// Scratch space of walkCut, one per thread and reused (no allocation per pixel
-// once it has grown); a nested walk on the same thread takes a fresh one.
+// Scratch space of walkCut, one per thread and kind of walk and reused (no
+// allocation per pixel once it has grown); a nested walk on the same thread takes a
+// fresh one. `Deferred`: the walk's visitor has deferred bounds (below); only then do
+// heap entries carry their state (a walk's heap operations move its entries, and the
+// other walks keep theirs at 20 bytes).
+template <bool Deferred>
 struct CutScratch {
+    struct NoState {};
+    struct DeferredState {
+        Rgb factor{0.0f};       // the factor the bound used (passed to the children)
+        bool tight = true;      // false while the bound is the cheap one
+        bool exceeded = false;  // the estimate exceeds the bound (counted in CutStatistics::boundExceeded)
+    };
+    using State = std::conditional_t<Deferred, DeferredState, NoState>;
+    struct ParentFactor {
+        Rgb factor{0.0f};
+        bool has = false;
+    };
     struct CutNode {
         float bound;  // luminance of the node's bound
         int32_t node;
         Rgb estimate;
-        Rgb factor{0.0f};   // deferred bounds: the factor the bound used (passed to the children)
-        bool tight = true;  // deferred bounds: false while the bound is the cheap one
-        bool exceeded = false;  // the estimate exceeds the bound (counted in CutStatistics::boundExceeded)
+        [[no_unique_address]] State state{};
         bool operator<(const CutNode& o) const { return bound != o.bound ? bound < o.bound : node > o.node; }
     };
     std::vector<CutNode> heap;      // a max-heap (std::push_heap) on bound
@@ -78,19 +94,15 @@ struct CutScratch {
         int32_t parent;  // the parent whose estimate it may inherit; -1: none (the root, the children
                          // of a crossed node that did not share its own parent's representative)
         Rgb parentEstimate;
-        Rgb factor{0.0f};          // deferred bounds: the parent's factor
-        bool hasFactor = false;
+        // Deferred bounds: the parent's factor, where there is one.
+        [[no_unique_address]] std::conditional_t<Deferred, ParentFactor, NoState> parentFactor{};
     };
     std::vector<Pending> pending;   // nodes to add to the cut (children of refined nodes)
     std::vector<CutNode> added;     // nodes with an estimate, to push on the heap
     std::vector<int32_t> queued;    // nodes to estimate, in one batch
     std::vector<Rgb> bounds, estimates;  // of the queued nodes
     std::vector<Rgb> addedBounds;       // of the added (inherited) nodes
-    struct Deferred {
-        Rgb factor;
-        bool tight;
-    };
-    std::vector<Deferred> deferred, addedDeferred;  // deferred bounds: of the queued and the added nodes
+    std::vector<State> states, addedStates;  // deferred bounds: of the queued and the added nodes
     bool inUse = false;
 };
 
@@ -110,12 +122,17 @@ inline constexpr int kRefineBatch = 4;
 template <class Visitor>
 Rgb walkCut(const LightTree& tree, const CutSettings& settings, CutStatistics& statistics, Visitor&& visitor,
             float otherLuminance = 0.0f) {
-    thread_local CutScratch threadScratch;
-    CutScratch localScratch;
-    CutScratch& scratch = threadScratch.inUse ? localScratch : threadScratch;
+    constexpr bool kDeferred = requires(Rgb& r, bool& t, const Rgb* f) {
+        { visitor.bound(int32_t(0), f, r, r, t) } -> std::convertible_to<bool>;
+        visitor.tighten(int32_t(0), r, r);
+    };
+    using Scratch = CutScratch<kDeferred>;
+    thread_local Scratch threadScratch;
+    Scratch localScratch;
+    Scratch& scratch = threadScratch.inUse ? localScratch : threadScratch;
     scratch.inUse = true;
     struct Release {
-        CutScratch& s;
+        Scratch& s;
         ~Release() { s.inUse = false; }
     } release{scratch};
     auto& heap = scratch.heap;
@@ -123,9 +140,6 @@ Rgb walkCut(const LightTree& tree, const CutSettings& settings, CutStatistics& s
     auto& queued = scratch.queued;
     auto& added = scratch.added;
     heap.clear(), pending.clear(), queued.clear(), scratch.bounds.clear();
-    constexpr bool kDeferred = requires(Rgb& r, bool& t, const Rgb* f) {
-        { visitor.bound(int32_t(0), f, r, r, t) } -> std::convertible_to<bool>;
-    };
     Rgb total(0.0f);
     uint32_t leavesInCut = 0;
     const auto& nodes = tree.nodes();
@@ -145,7 +159,7 @@ Rgb walkCut(const LightTree& tree, const CutSettings& settings, CutStatistics& s
         return key >= 0.0f ? key : std::numeric_limits<float>::infinity();  // NaN: refine
     };
     // Adds a node with its estimate and bound to the cut.
-    const auto addToCut = [&](int32_t i, const Rgb& e, const Rgb& b, const CutScratch::Deferred& d) {
+    const auto addToCut = [&](int32_t i, const Rgb& e, const Rgb& b, const typename Scratch::State& d) {
         total += e;
         ++statistics.evaluated;
         if (nodes[i].isLeaf()) {
@@ -155,24 +169,27 @@ Rgb walkCut(const LightTree& tree, const CutSettings& settings, CutStatistics& s
         ++statistics.boundedEstimates;
         const bool exceeded = exceeds(e, b);
         if (exceeded) ++statistics.boundExceeded;
-        heap.push_back({heapKey(b), i, e, d.factor, d.tight, exceeded});
+        typename Scratch::CutNode entry{heapKey(b), i, e, d};
+        if constexpr (kDeferred) entry.state.exceeded = exceeded;
+        heap.push_back(entry);
         std::push_heap(heap.begin(), heap.end());
     };
     // Adds the nodes in `pending` (and, for crossed nodes, their children) to the cut.
     const auto addPending = [&] {
         queued.clear(), scratch.bounds.clear(), added.clear(), scratch.addedBounds.clear();
-        scratch.deferred.clear(), scratch.addedDeferred.clear();
+        scratch.states.clear(), scratch.addedStates.clear();
         while (!pending.empty()) {
-            const CutScratch::Pending p = pending.back();
+            const typename Scratch::Pending p = pending.back();
             pending.pop_back();
             const int32_t i = p.node;
             const LightTreeNode& node = nodes[i];
             Rgb b(0.0f);
-            CutScratch::Deferred d{Rgb(0.0f), true};
+            typename Scratch::State d{};
             bool crossed = false;
             if (!node.isLeaf()) {
                 if constexpr (kDeferred)
-                    crossed = !visitor.bound(i, p.hasFactor ? &p.factor : nullptr, b, d.factor, d.tight);
+                    crossed = !visitor.bound(i, p.parentFactor.has ? &p.parentFactor.factor : nullptr, b, d.factor,
+                                             d.tight);
                 else
                     crossed = !visitor.bound(i, b);
             }
@@ -183,19 +200,19 @@ Rgb walkCut(const LightTree& tree, const CutSettings& settings, CutStatistics& s
                 // representative: its children may inherit from it. Its children get the
                 // factor it was given (their boxes lie in its parent's).
                 const Rgb e = shares ? inherit(p.parentEstimate, p.parent, i) : Rgb(0.0f);
-                pending.push_back({node.left, shares ? i : -1, e, p.factor, p.hasFactor});
-                pending.push_back({node.right, shares ? i : -1, e, p.factor, p.hasFactor});
+                pending.push_back({node.left, shares ? i : -1, e, p.parentFactor});
+                pending.push_back({node.right, shares ? i : -1, e, p.parentFactor});
                 continue;
             }
             if (shares) {
                 added.push_back({0.0f, i, inherit(p.parentEstimate, p.parent, i)});
                 scratch.addedBounds.push_back(b);
-                scratch.addedDeferred.push_back(d);
+                scratch.addedStates.push_back(d);
                 continue;
             }
             queued.push_back(i);
             scratch.bounds.push_back(b);
-            scratch.deferred.push_back(d);
+            scratch.states.push_back(d);
         }
         scratch.estimates.resize(queued.size());
         if constexpr (requires { visitor.evaluate(queued.data(), scratch.estimates.data(), queued.size()); }) {
@@ -205,32 +222,32 @@ Rgb walkCut(const LightTree& tree, const CutSettings& settings, CutStatistics& s
                 scratch.estimates[k] = nodes[queued[k]].isLeaf() ? visitor.leaf(queued[k]) : visitor.estimate(queued[k]);
         }
         for (size_t a = 0; a < added.size(); ++a)
-            addToCut(added[a].node, added[a].estimate, scratch.addedBounds[a], scratch.addedDeferred[a]);
+            addToCut(added[a].node, added[a].estimate, scratch.addedBounds[a], scratch.addedStates[a]);
         for (size_t q = 0; q < queued.size(); ++q)
-            addToCut(queued[q], scratch.estimates[q], scratch.bounds[q], scratch.deferred[q]);
+            addToCut(queued[q], scratch.estimates[q], scratch.bounds[q], scratch.states[q]);
     };
     pending.push_back({tree.root(), -1, Rgb(0.0f)});
     addPending();
     while (!heap.empty()) {
         const float threshold = settings.errorThreshold * (std::max(0.0f, luminance(total)) + otherLuminance);
         for (int refined = 0; refined < kRefineBatch && !heap.empty();) {
-            CutScratch::CutNode top = heap.front();
+            typename Scratch::CutNode top = heap.front();
             if (top.bound <= threshold) break;
             // The cut's size after `refined` refinements of this batch (each adds one node).
             if (heap.size() + leavesInCut + 2 * size_t(refined) >= settings.maxCutSize) break;
             std::pop_heap(heap.begin(), heap.end());
             heap.pop_back();
             if constexpr (kDeferred) {
-                if (!top.tight) {  // above the threshold on its cheap bound: make it tight, and look again
+                if (!top.state.tight) {  // above the threshold on its cheap bound: make it tight, and look again
                     Rgb b(0.0f);
-                    visitor.bound(top.node, nullptr, b, top.factor, top.tight);  // not crossed: its distance is known
-                    top.tight = true;
+                    visitor.tighten(top.node, b, top.state.factor);
+                    top.state.tight = true;
                     const bool nowExceeded = exceeds(top.estimate, b);
-                    if (nowExceeded != top.exceeded) {  // count the node against the bound it now has
+                    if (nowExceeded != top.state.exceeded) {  // count the node against the bound it now has
                         if (nowExceeded) ++statistics.boundExceeded;
                         else --statistics.boundExceeded;
                     }
-                    top.exceeded = nowExceeded;
+                    top.state.exceeded = nowExceeded;
                     top.bound = heapKey(b);
                     heap.push_back(top);
                     std::push_heap(heap.begin(), heap.end());
@@ -238,8 +255,13 @@ Rgb walkCut(const LightTree& tree, const CutSettings& settings, CutStatistics& s
                 }
             }
             total -= top.estimate;
-            pending.push_back({nodes[top.node].right, top.node, top.estimate, top.factor, kDeferred});
-            pending.push_back({nodes[top.node].left, top.node, top.estimate, top.factor, kDeferred});
+            if constexpr (kDeferred) {
+                pending.push_back({nodes[top.node].right, top.node, top.estimate, {top.state.factor, true}});
+                pending.push_back({nodes[top.node].left, top.node, top.estimate, {top.state.factor, true}});
+            } else {
+                pending.push_back({nodes[top.node].right, top.node, top.estimate});
+                pending.push_back({nodes[top.node].left, top.node, top.estimate});
+            }
             ++refined;
         }
         if (pending.empty()) break;

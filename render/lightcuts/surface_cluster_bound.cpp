@@ -127,26 +127,41 @@ Rgb SurfaceClusterBound::reflectionTowardsBox(const CameraPathSurface& x, const 
     return fCos;
 }
 
-Rgb SurfaceClusterBound::bound(int32_t index, const CameraPathSurface& x, bool* xInsideNode) const {
-    return bound(index, x, xInsideNode, nullptr, nullptr, nullptr);
+double SurfaceClusterBound::slackOf(const Imath::Box3f& box, const Vec3& p) {
+    const float reach = std::max({std::abs(box.min.x), std::abs(box.min.y), std::abs(box.min.z), std::abs(box.max.x),
+                                  std::abs(box.max.y), std::abs(box.max.z)});
+    return 8.0 * 0x1p-24 * (double(p.length()) + reach);
 }
 
-Rgb SurfaceClusterBound::bound(int32_t index, const CameraPathSurface& x, bool* xInsideNode,
-                               const Rgb* inheritedGlossy, Rgb* factor, bool* tight) const {
-    const LightTreeNode& node = tree_.nodes()[index];
+Rgb SurfaceClusterBound::bound(int32_t index, const CameraPathSurface& x, bool* xInsideNode, Rgb* factor) const {
+    const Imath::Box3f& box = tree_.nodes()[index].box;
+    const double slack = slackOf(box, x.hit.position);
+    const double d = minimumDistance(index, x.hit.position) - slack;
+    if (xInsideNode) *xInsideNode = !(d > 0.0);
+    return boundAt(index, x, d, slack, nullptr, factor);
+}
+
+Rgb SurfaceClusterBound::cheapBound(int32_t index, const CameraPathSurface& x, bool* xInsideNode,
+                                    const Rgb* inheritedGlossy, Rgb* factor, bool* tight) const {
     const Vec3& p = x.hit.position;
-    const float reach = std::max({std::abs(node.box.min.x), std::abs(node.box.min.y), std::abs(node.box.min.z),
-                                  std::abs(node.box.max.x), std::abs(node.box.max.y), std::abs(node.box.max.z)});
-    const double slack = 8.0 * 0x1p-24 * (double(p.length()) + reach);
+    const double slack = slackOf(tree_.nodes()[index].box, p);
     const double d = minimumDistance(index, p) - slack;
     if (xInsideNode) *xInsideNode = !(d > 0.0);
+    const bool glossyInherited = inheritedGlossy && !x.bsdf.lambertianBound().has_value();
+    if (tight) *tight = !glossyInherited;
+    return boundAt(index, x, d, slack, glossyInherited ? inheritedGlossy : nullptr, factor);
+}
+
+Rgb SurfaceClusterBound::boundAt(int32_t index, const CameraPathSurface& x, double d, double slack,
+                                 const Rgb* inheritedGlossy, Rgb* factor) const {
+    const LightTreeNode& node = tree_.nodes()[index];
+    const Vec3& p = x.hit.position;
     if (!(d > 0.0)) return Rgb(std::numeric_limits<float>::infinity());
 
     const SceneShape& shape = scene_.shapes()[x.hit.shape];
     const bool reflectsOnly = shape.bsdf.kind() != BsdfDescription::Kind::RoughDielectric;
     const Rgb fCos = reflectionTowardsBox(x, shape.bsdf, node.box, d, slack, settings_.glossyMargin, inheritedGlossy);
     if (factor) *factor = fCos;
-    if (tight) *tight = !inheritedGlossy || x.bsdf.lambertianBound().has_value();
     if (isBlack(fCos)) return Rgb(0.0f);
 
     const HomogeneousMedium* vrlMedium = node.medium >= 0 ? &scene_.media()[node.medium] : nullptr;

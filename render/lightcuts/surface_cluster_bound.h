@@ -62,14 +62,17 @@ public:
 
     // RGB bound for `node` lighting `x`; +infinity (and *xInsideNode = true) when
     // x lies in the node's box (or on one of a small node's segments).
-    Rgb bound(int32_t node, const CameraPathSurface& x, bool* xInsideNode = nullptr) const;
-    // The same with the receiver's factor (f_s|cos| above) returned in *factor. For a
-    // glossy x, a given `inheritedGlossy` (the factor of a box holding this node's box,
-    // its parent's) replaces the 10 BSDF evaluations: a cheaper heuristic, since the
-    // directions to the node are among those to the parent box (deferred bounds,
-    // cut_walk.h); *tight says whether the full bound was computed.
-    Rgb bound(int32_t node, const CameraPathSurface& x, bool* xInsideNode, const Rgb* inheritedGlossy, Rgb* factor,
-              bool* tight) const;
+    // *factor (optional): the receiver's factor f_s|cos| it used (below).
+    Rgb bound(int32_t node, const CameraPathSurface& x, bool* xInsideNode = nullptr, Rgb* factor = nullptr) const;
+    // A cheaper bound for the cut's deferred bounds (cut_walk.h); *tight says whether it
+    // is the full one. For a glossy x, given `inheritedGlossy` (the factor of a box that
+    // holds this node's box: its parent's), it takes that factor instead of the 10 BSDF
+    // evaluations, a heuristic as theirs is: the directions to the node are among those
+    // to the parent's box. Elsewhere it is the full bound. (Deferring a small node's exact
+    // distance as well, with the box's distance as the cheap one, made renders slower:
+    // nearly every such node reached the heap's top and paid for both.)
+    Rgb cheapBound(int32_t node, const CameraPathSurface& x, bool* xInsideNode, const Rgb* inheritedGlossy,
+                   Rgb* factor, bool* tight) const;
     // The distance from x to the node used by the bound (box, or exact for small nodes).
     double minimumDistance(int32_t node, const Vec3& x) const;
     // Whether the bound is proven for the BSDF at x (diffuse) or a heuristic (glossy).
@@ -85,6 +88,11 @@ public:
                                     double slack, float glossyMargin, const Rgb* inheritedGlossy = nullptr);
 
 private:
+    // The bound at distance >= d (after the rounding slack; d <= 0: x may lie in the node).
+    Rgb boundAt(int32_t node, const CameraPathSurface& x, double d, double slack, const Rgb* inheritedGlossy,
+                Rgb* factor) const;
+    // The rounding slack of distances between x and the node's box.
+    static double slackOf(const Imath::Box3f& box, const Vec3& x);
     // The bound on f_p (see above) for the node's VRLs lighting x at distance >= d.
     double phaseBound(int32_t node, const Vec3& x, double slack, double d) const;
 

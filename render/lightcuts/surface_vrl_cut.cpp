@@ -24,9 +24,10 @@ Rgb SurfaceLightcutsEstimator::estimate(const CameraPathSurface& x, uint64_t str
         }
         bool bound(int32_t i, const Rgb* inherited, Rgb& b, Rgb& factor, bool& tight) const {
             bool inside = false;
-            b = self.bound_.bound(i, x, &inside, inherited, &factor, &tight);
+            b = self.bound_.cheapBound(i, x, &inside, inherited, &factor, &tight);
             return !inside;
         }
+        void tighten(int32_t i, Rgb& b, Rgb& factor) const { b = self.bound_.bound(i, x, nullptr, &factor); }
         Rgb estimate(int32_t i) const {
             const LightTreeNode& node = self.tree_.nodes()[i];
             Vrl representative = self.tree_.vrls()[node.representative];

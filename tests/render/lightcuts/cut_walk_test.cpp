@@ -97,6 +97,10 @@ struct SyntheticDeferred : Synthetic {
         b = n.clusterFlux * factor;
         return true;
     }
+    void tighten(int32_t i, Rgb& b, Rgb& factor) const {
+        bool tight = false;
+        bound(i, nullptr, b, factor, tight);
+    }
 };
 
 struct SyntheticBatched : Synthetic {
