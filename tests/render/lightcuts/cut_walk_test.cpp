@@ -198,19 +198,26 @@ TEST(CutWalk, CrossedNodesPassTheirRepresentativesEstimateOn) {
     EXPECT_LT(relativeDifference(total, exact), 1e-5);
 }
 
+// Walks with visitors a and b at `threshold` and expects the same bits, the same
+// nodes evaluated in the same order and the same #Eval; their statistics in sa, sb.
+template <class A, class B>
+void expectSameWalk(const LightTree& tree, float threshold, A& a, B& b, CutStatistics& sa, CutStatistics& sb) {
+    const Rgb ta = walkCut(tree, settingsFor(threshold), sa, a);
+    const Rgb tb = walkCut(tree, settingsFor(threshold), sb, b);
+    EXPECT_EQ(ta.x, tb.x);
+    EXPECT_EQ(ta.y, tb.y);
+    EXPECT_EQ(ta.z, tb.z);
+    EXPECT_EQ(sa.evaluated, sb.evaluated);
+    EXPECT_EQ(a.evaluatedNodes, b.evaluatedNodes);
+}
+
 TEST(CutWalk, BatchedAndPerNodeEvaluationGiveTheSameBits) {
     const LightTree tree = LightTree::build(randomVrls(3000, 3));
     for (float threshold : {0.0f, 0.001f, 0.02f, 0.2f}) {
         Synthetic a{tree, 11};
         SyntheticBatched b{tree, 11};
         CutStatistics sa, sb;
-        const Rgb ta = walkCut(tree, settingsFor(threshold), sa, a);
-        const Rgb tb = walkCut(tree, settingsFor(threshold), sb, b);
-        EXPECT_EQ(ta.x, tb.x);
-        EXPECT_EQ(ta.y, tb.y);
-        EXPECT_EQ(ta.z, tb.z);
-        EXPECT_EQ(sa.evaluated, sb.evaluated);
-        EXPECT_EQ(a.evaluatedNodes, b.evaluatedNodes);
+        expectSameWalk(tree, threshold, a, b, sa, sb);
     }
 }
 
@@ -270,13 +277,7 @@ TEST(CutWalk, DeferredBoundsKeepTheCutAndSkipTightBoundsOfNodesNotRefined) {
                 Synthetic tightEverywhere{tree, cross, scale};
                 SyntheticDeferred deferred{tree, cross, scale};
                 CutStatistics st, sd;
-                const Rgb tt = walkCut(tree, settingsFor(threshold), st, tightEverywhere);
-                const Rgb td = walkCut(tree, settingsFor(threshold), sd, deferred);
-                EXPECT_EQ(tt.x, td.x);
-                EXPECT_EQ(tt.y, td.y);
-                EXPECT_EQ(tt.z, td.z);
-                EXPECT_EQ(tightEverywhere.evaluatedNodes, deferred.evaluatedNodes);
-                EXPECT_EQ(st.evaluated, sd.evaluated);
+                expectSameWalk(tree, threshold, tightEverywhere, deferred, st, sd);
                 EXPECT_EQ(st.cutSize, sd.cutSize);
                 EXPECT_EQ(st.intersected, sd.intersected);
                 EXPECT_EQ(st.boundedEstimates, sd.boundedEstimates);
