@@ -5,7 +5,10 @@
 // The cut: starting at the root, the inner node of largest importance is
 // replaced by its children until the cut holds `cutSize` nodes or only
 // leaves. Any cut is a partition of the leaves, so the total is the sum over
-// the cut's nodes of each node's own sum, whatever rule chose the cut.
+// the cut's nodes of each node's own sum, whatever rule chose the cut. A child
+// whose importance is 0 while its sibling's is positive is left out of the cut:
+// its contribution is 0 (below), and a descent through its parent would never
+// take it anyway; the slot goes to a node that can contribute.
 //
 // The descent, per cut node C: from C down to a leaf, at each inner node the
 // left child is taken with probability p_L = I_L / (I_L + I_R) (I: importance),
@@ -98,6 +101,10 @@ void stochasticCut(const LightTree& tree, uint32_t cutSize, Importance&& importa
         const ChildImportances c = importance(i);
         if (importanceEvaluations) *importanceEvaluations += 2;
         for (int k = 0; k < 2; ++k) {
+            // A child of importance 0 beside a positive, finite sibling: a descent from
+            // this node never takes it (leftProbability), because its contribution is 0
+            // (the importance's contract), so it takes no slot of the cut either.
+            if (c.value[k] == 0.0 && c.value[1 - k] > 0.0 && std::isfinite(c.value[1 - k])) continue;
             if (isLeafNode(tree, c.node[k])) {
                 cut.push_back(c.node[k]);
                 continue;

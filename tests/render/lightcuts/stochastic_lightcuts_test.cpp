@@ -193,6 +193,43 @@ TEST(StochasticCut, EveryContributingVrlIsReachableAndProbabilitiesSumToTheCutSi
     EXPECT_GT(zeroProbability, 0u) << "no VRL behind a surface point: the zero-importance case is not exercised";
 }
 
+// A child of importance 0 beside a positive sibling takes no slot of the cut: with a
+// synthetic importance (the number of VRLs under a node on the positive-x side, so 0
+// exactly where nothing under it contributes), every cut node holds a contributing VRL,
+// the cut still has K nodes, every contributing VRL stays reachable and the
+// probabilities sum to the cut's size. (Before, zero nodes kept their slots.)
+TEST(StochasticCut, ZeroImportanceChildrenTakeNoSlot) {
+    Rng rng(11, 0);
+    const LightTree tree = LightTree::build(randomVrls(rng, 3000), LightTreeSettings{256, 11});
+    std::vector<double> positive(tree.nodes().size(), 0.0);
+    const auto countPositive = [&](auto&& self, int32_t node) -> double {
+        const LightTreeNode& n = tree.nodes()[node];
+        if (n.isLeaf()) return positive[node] = tree.vrls()[n.representative].origin.x > 0.0f ? 1.0 : 0.0;
+        return positive[node] = self(self, n.left) + self(self, n.right);
+    };
+    countPositive(countPositive, tree.root());
+    const auto importance = [&](int32_t n) {
+        const LightTreeNode& node = tree.nodes()[n];
+        return ChildImportances{{node.left, node.right}, {positive[node.left], positive[node.right]}};
+    };
+    for (const uint32_t cutSize : {2u, 16u, 64u, 256u}) {
+        const std::vector<int32_t> cut = stochasticCut(tree, cutSize, importance);
+        EXPECT_EQ(cut.size(), cutSize);
+        for (const int32_t node : cut) EXPECT_GT(positive[node], 0.0) << "a cut node with nothing to contribute";
+        const std::vector<double> p = stochasticLeafProbabilities(tree, cutSize, importance);
+        double sum = 0.0;
+        for (uint32_t k = 0; k < p.size(); ++k) {
+            sum += p[k];
+            if (tree.vrls()[k].origin.x > 0.0f) {
+                EXPECT_GT(p[k], 0.0) << "contributing VRL " << k << " unreachable";
+            } else {
+                EXPECT_EQ(p[k], 0.0);
+            }
+        }
+        EXPECT_NEAR(sum, double(cut.size()), 1e-9 * double(cut.size()));
+    }
+}
+
 struct MeanAndError {
     Rgb mean{0.0f}, standardError{0.0f};
 };
