@@ -182,10 +182,13 @@ TransportIntegrator::VirtualLightParts TransportIntegrator::virtualLightParts(co
             const uint64_t streamKey = Rng::combine(pixelKey, segmentIndex++ | (uint64_t(1) << 63));
             if (scene_.media()[segment.medium].isNonScattering()) continue;
             if (settings_.maxDepth >= 0 && settings_.maxDepth < segment.specularBefore + 3) continue;
-            parts.singleSurface += surfaceVplLightcuts_ && settings_.surfaceVplCut
-                                       ? surfaceVplLightcuts_->estimate(segment, streamKey, statistics,
-                                                                        other + std::max(0.0f, luminance(parts.singleSurface)))
-                                       : sumOverSurfaceVpls(surfaceVplEstimator_, surfaceVpls_->vpls, segment, streamKey);
+            if (surfaceVplLightcuts_ && settings_.surfaceVplCut)
+                parts.singleSurface += surfaceVplLightcuts_->estimate(
+                    segment, streamKey, statistics, other + std::max(0.0f, luminance(parts.singleSurface)));
+            else if (surfaceVplLightcuts_)  // plain, with the VPLs' BSDFs prepared once
+                parts.singleSurface += surfaceVplLightcuts_->sumAll(segment, streamKey);
+            else
+                parts.singleSurface += sumOverSurfaceVpls(surfaceVplEstimator_, surfaceVpls_->vpls, segment, streamKey);
         }
     }
     return parts;

@@ -241,6 +241,17 @@ Rgb SurfaceVplLightcutsEstimator::estimate(const CameraSegment& segment, uint64_
     return walkCut(tree, settings_, statistics, Visitor{*this, segment, streamKey}, otherLuminance);
 }
 
+Rgb SurfaceVplLightcutsEstimator::sumAll(const CameraSegment& segment, uint64_t streamKey) const {
+    const std::vector<SurfaceVpl>& vpls = lights_.vpls;
+    if (atVpl_.size() != vpls.size()) return sumOverSurfaceVpls(estimator_, vpls, segment, streamKey);  // no tree
+    Rgb sum(0.0f);
+    for (uint32_t k = 0; k < vpls.size(); ++k) {
+        Rng rng = vrlStream(streamKey, k);
+        sum += estimator_.contribution(vpls[k], atVpl_[k], vpls[k].flux, segment, rng);
+    }
+    return sum;
+}
+
 Rgb sumOverSurfaceVpls(const SurfaceVplEstimator& estimator, const std::vector<SurfaceVpl>& vpls,
                        const CameraSegment& segment, uint64_t streamKey) {
     Rgb sum(0.0f);

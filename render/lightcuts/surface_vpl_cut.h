@@ -131,6 +131,9 @@ public:
     // The medium-then-surface light along `segment` from every VPL, by a cut.
     Rgb estimate(const CameraSegment& segment, uint64_t streamKey, CutStatistics& statistics,
                  float otherLuminance = 0.0f) const;
+    // Plain shading of (b)'s surface light, every VPL against `segment` (sumOverSurfaceVpls),
+    // with the VPLs' BSDFs prepared once (atVpl_): bit for bit the same sum.
+    Rgb sumAll(const CameraSegment& segment, uint64_t streamKey) const;
 
     // The bound above for node `node` and `segment`; infinite where the segment may meet the box.
     Rgb bound(int32_t node, const CameraSegment& segment) const;
