@@ -42,7 +42,8 @@ struct CutStatistics {
                                // no estimator call, cut_walk.h)
     uint32_t intersected = 0;  // #Inter: nodes whose box the camera line crossed
     uint32_t cutSize = 0;      // nodes in the final cut
-    uint32_t boundExceeded = 0;  // inner-node estimates above their bound (HG media; 0 if isotropic)
+    uint32_t boundExceeded = 0;  // inner-node estimates above the bound they last had (heuristic bounds:
+                                 // VPL cuts' HG, glossy receivers, deferred cheap bounds; cut_walk.h)
     uint32_t boundedEstimates = 0;  // inner-node estimates checked against their bound
     uint32_t importanceEvaluations = 0;  // stochastic cuts: node importances computed (cut and descents)
 

@@ -105,6 +105,7 @@ struct CutScratch {
     std::vector<State> states, addedStates;  // deferred bounds: of the queued and the added nodes
     bool inUse = false;
 };
+static_assert(sizeof(CutScratch<false>::CutNode) == 20, "walks without deferred bounds keep 20-byte heap entries");
 
 // `otherLuminance`: the luminance of what the pixel receives besides this cut
 // (0: the cut's own total is the reference, as in the paper's media-only images); the
@@ -177,7 +178,7 @@ Rgb walkCut(const LightTree& tree, const CutSettings& settings, CutStatistics& s
     // Adds the nodes in `pending` (and, for crossed nodes, their children) to the cut.
     const auto addPending = [&] {
         queued.clear(), scratch.bounds.clear(), added.clear(), scratch.addedBounds.clear();
-        scratch.states.clear(), scratch.addedStates.clear();
+        if constexpr (kDeferred) scratch.states.clear(), scratch.addedStates.clear();
         while (!pending.empty()) {
             const typename Scratch::Pending p = pending.back();
             pending.pop_back();
@@ -207,12 +208,12 @@ Rgb walkCut(const LightTree& tree, const CutSettings& settings, CutStatistics& s
             if (shares) {
                 added.push_back({0.0f, i, inherit(p.parentEstimate, p.parent, i)});
                 scratch.addedBounds.push_back(b);
-                scratch.addedStates.push_back(d);
+                if constexpr (kDeferred) scratch.addedStates.push_back(d);
                 continue;
             }
             queued.push_back(i);
             scratch.bounds.push_back(b);
-            scratch.states.push_back(d);
+            if constexpr (kDeferred) scratch.states.push_back(d);
         }
         scratch.estimates.resize(queued.size());
         if constexpr (requires { visitor.evaluate(queued.data(), scratch.estimates.data(), queued.size()); }) {
@@ -221,10 +222,14 @@ Rgb walkCut(const LightTree& tree, const CutSettings& settings, CutStatistics& s
             for (size_t k = 0; k < queued.size(); ++k)
                 scratch.estimates[k] = nodes[queued[k]].isLeaf() ? visitor.leaf(queued[k]) : visitor.estimate(queued[k]);
         }
+        const auto stateOf = [&](const std::vector<typename Scratch::State>& states, size_t k) {
+            if constexpr (kDeferred) return states[k];
+            else return typename Scratch::State{};
+        };
         for (size_t a = 0; a < added.size(); ++a)
-            addToCut(added[a].node, added[a].estimate, scratch.addedBounds[a], scratch.addedStates[a]);
+            addToCut(added[a].node, added[a].estimate, scratch.addedBounds[a], stateOf(scratch.addedStates, a));
         for (size_t q = 0; q < queued.size(); ++q)
-            addToCut(queued[q], scratch.estimates[q], scratch.bounds[q], scratch.states[q]);
+            addToCut(queued[q], scratch.estimates[q], scratch.bounds[q], stateOf(scratch.states, q));
     };
     pending.push_back({tree.root(), -1, Rgb(0.0f)});
     addPending();

@@ -4,11 +4,12 @@
 //
 // The cut: starting at the root, the inner node of largest importance is
 // replaced by its children until the cut holds `cutSize` nodes or only
-// leaves. Any cut is a partition of the leaves, so the total is the sum over
-// the cut's nodes of each node's own sum, whatever rule chose the cut. A child
-// whose importance is 0 while its sibling's is positive is left out of the cut:
-// its contribution is 0 (below), and a descent through its parent would never
-// take it anyway; the slot goes to a node that can contribute.
+// leaves. The cut's nodes and the children left out of it (below) partition the
+// leaves, so the total is the sum over the cut's nodes of each node's own sum,
+// whatever rule chose the cut. A child whose importance is 0 while its sibling's
+// is positive is left out of the cut: its contribution is 0 (below), and a descent
+// through its parent would never take it anyway; the slot goes to a node that can
+// contribute.
 //
 // The descent, per cut node C: from C down to a leaf, at each inner node the
 // left child is taken with probability p_L = I_L / (I_L + I_R) (I: importance),

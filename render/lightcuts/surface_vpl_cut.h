@@ -68,9 +68,9 @@
 // x's shape bounding no medium, so the segment x-y stays inside it, else 1. Sum
 // over the representative's weighting as above: at most I_C c_y F_x T / max(d, R)^2.
 // Only the VPLs part (a) takes (reflectsBroadly) contribute; the others give 0, so
-// I_C there sums the I_k of those alone (0 for a node of narrow-lobe VPLs: such a
-// node is refined last, and a draw under it, which can happen only when it is in
-// the cut, gives 0). The clamp makes every bound finite, even for a box that holds x. Part (a) takes
+// I_C there sums the I_k of those alone (0 for a node of narrow-lobe VPLs: beside a
+// sibling of positive bound such a node takes no slot of the stochastic cut and no
+// descent takes it (stochastic_cut.h); only where every node is 0 is one drawn, and it gives 0). The clamp makes every bound finite, even for a box that holds x. Part (a) takes
 // this bound as the importance of a stochastic cut (sample, below): VPLs are drawn
 // in proportion to it, so a draw's estimate / probability stays near the node's
 // bound where visibility and the cosines are near their bounds.

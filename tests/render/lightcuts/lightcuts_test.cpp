@@ -73,6 +73,16 @@ TEST(Lightcuts, SurfaceErrorShrinksWithThresholdInLitRoom) {
     expectErrorControl(*scene, "lit room", "medium-surface");
 }
 
+// Glossy receivers (a rough-plastic occluder, α 0.1, and a rough-conductor wall panel,
+// α 0.4): part (c)'s cut takes their bound factor from the parent node until a node
+// may be refined (deferred bounds, cut_walk.h), a heuristic like the glossy bound
+// itself; the error still shrinks with the threshold and stays below it, and
+// threshold 0 refines to every VRL.
+TEST(Lightcuts, SurfaceErrorShrinksWithThresholdInGlossyRoom) {
+    const auto scene = Scene::build(test::roomWithGlossyReflectors(Rgb(0.4f), Rgb(0.1f), 0.0f));
+    expectErrorControl(*scene, "glossy room", "medium-surface");
+}
+
 // The whole four-part image: the path-sampled parts draw the same numbers in
 // both methods, so the images differ by the two cuts alone; part (c)'s cut
 // measures its error against the whole pixel, and the image's relative RMSE
