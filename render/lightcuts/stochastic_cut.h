@@ -66,6 +66,14 @@ inline double leftProbability(const ChildImportances& c, const LightTree& tree) 
     return 0.5;
 }
 
+// Whether a descent from the parent never takes child k: its importance is 0 beside a
+// positive, finite sibling, where leftProbability gives it probability 0 (the ratio
+// branch). The cut gives such a child no slot, since its contribution is 0 (the
+// importance's contract): the cut and the descent follow this one rule.
+inline bool neverTaken(const ChildImportances& c, int k) {
+    return c.value[k] == 0.0 && c.value[1 - k] > 0.0 && std::isfinite(c.value[1 - k]);
+}
+
 // Leaves are the tree's first vrls().size() nodes (light_tree.h).
 inline bool isLeafNode(const LightTree& tree, int32_t node) { return size_t(node) < tree.vrls().size(); }
 
@@ -102,10 +110,7 @@ void stochasticCut(const LightTree& tree, uint32_t cutSize, Importance&& importa
         const ChildImportances c = importance(i);
         if (importanceEvaluations) *importanceEvaluations += 2;
         for (int k = 0; k < 2; ++k) {
-            // A child of importance 0 beside a positive, finite sibling: a descent from
-            // this node never takes it (leftProbability), because its contribution is 0
-            // (the importance's contract), so it takes no slot of the cut either.
-            if (c.value[k] == 0.0 && c.value[1 - k] > 0.0 && std::isfinite(c.value[1 - k])) continue;
+            if (neverTaken(c, k)) continue;  // no slot: nothing under it contributes
             if (isLeafNode(tree, c.node[k])) {
                 cut.push_back(c.node[k]);
                 continue;

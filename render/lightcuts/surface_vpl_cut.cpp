@@ -7,8 +7,11 @@
 #include "render/vrl/vrl_estimator.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
+#include <stdexcept>
+#include <string>
 
 namespace vrl {
 
@@ -147,10 +150,11 @@ Rgb SurfaceVplLightcutsEstimator::bound(int32_t index, const CameraSegment& segm
            float(kRoundingMargin * phaseMax * geometry);
 }
 
-Rgb SurfaceVplLightcutsEstimator::bound(int32_t index, const CameraPathSurface& x, float radius) const {
+std::array<double, 3> SurfaceVplLightcutsEstimator::pointBound(int32_t index, const CameraPathSurface& x,
+                                                              float radius) const {
     const LightTreeNode& node = lights_.tree.nodes()[size_t(index)];
     const Rgb& intensity = broadIntensity_[size_t(index)];  // only the VPLs part (a) takes
-    if (isBlack(intensity)) return Rgb(0.0f);
+    if (isBlack(intensity)) return {0.0, 0.0, 0.0};
     const Vec3& p = x.hit.position;
     const float reach = std::max({std::abs(node.box.min.x), std::abs(node.box.min.y), std::abs(node.box.min.z),
                                   std::abs(node.box.max.x), std::abs(node.box.max.y), std::abs(node.box.max.z)});
@@ -161,7 +165,7 @@ Rgb SurfaceVplLightcutsEstimator::bound(int32_t index, const CameraPathSurface& 
     const SceneShape& shape = scene_.shapes()[x.hit.shape];
     const Rgb fCos = SurfaceClusterBound::reflectionTowardsBox(x, shape.bsdf, node.box, dPositive, slack,
                                                                settings_.bound.glossyMargin);
-    if (isBlack(fCos)) return Rgb(0.0f);
+    if (isBlack(fCos)) return {0.0, 0.0, 0.0};
     double cosine = 1.0;  // at y (surface_vpl_cut.h)
     if (d > 0.0 && !normals_.empty() && normals_[size_t(index)].spread >= 0.0f && normals_[size_t(index)].spread < 1.0f) {
         const NormalBound& n = normals_[size_t(index)];
@@ -174,15 +178,26 @@ Rgb SurfaceVplLightcutsEstimator::bound(int32_t index, const CameraPathSurface& 
         scene_.media()[size_t(node.medium)].boundaryConvex())
         transmittance = scene_.media()[size_t(node.medium)].transmittanceBound(d);
     const double clamped = std::max(std::max(d, 0.0), double(radius));
-    return intensity * fCos * transmittance * x.throughput * float(kRoundingMargin * cosine / (clamped * clamped));
+    // In double: a float product of these factors could round to 0 where the VPLs still
+    // contribute denormals, and an importance of 0 beside a positive sibling is never drawn.
+    const double scale = kRoundingMargin * cosine / (clamped * clamped);
+    std::array<double, 3> b{};
+    for (int c = 0; c < 3; ++c)
+        b[size_t(c)] = double(intensity[c]) * double(fCos[c]) * double(transmittance[c]) * double(x.throughput[c]) * scale;
+    return b;
+}
+
+Rgb SurfaceVplLightcutsEstimator::bound(int32_t index, const CameraPathSurface& x, float radius) const {
+    const std::array<double, 3> b = pointBound(index, x, radius);
+    return Rgb(float(b[0]), float(b[1]), float(b[2]));
 }
 
 ChildImportances SurfaceVplLightcutsEstimator::importances(int32_t node, const CameraPathSurface& x,
                                                           float radius) const {
     const LightTreeNode& n = lights_.tree.nodes()[size_t(node)];
     const auto importanceOf = [&](int32_t child) {
-        const Rgb b = bound(child, x, radius);
-        return double(b.x) + double(b.y) + double(b.z);
+        const std::array<double, 3> b = pointBound(child, x, radius);
+        return b[0] + b[1] + b[2];
     };
     return ChildImportances{{n.left, n.right}, {importanceOf(n.left), importanceOf(n.right)}};
 }
@@ -242,22 +257,19 @@ Rgb SurfaceVplLightcutsEstimator::estimate(const CameraSegment& segment, uint64_
 }
 
 Rgb SurfaceVplLightcutsEstimator::sumAll(const CameraSegment& segment, uint64_t streamKey) const {
-    const std::vector<SurfaceVpl>& vpls = lights_.vpls;
-    if (atVpl_.size() != vpls.size()) return sumOverSurfaceVpls(estimator_, vpls, segment, streamKey);  // no tree
-    Rgb sum(0.0f);
-    for (uint32_t k = 0; k < vpls.size(); ++k) {
-        Rng rng = vrlStream(streamKey, k);
-        sum += estimator_.contribution(vpls[k], atVpl_[k], vpls[k].flux, segment, rng);
-    }
-    return sum;
+    return sumOverSurfaceVpls(estimator_, lights_.vpls, segment, streamKey, &atVpl_);
 }
 
 Rgb sumOverSurfaceVpls(const SurfaceVplEstimator& estimator, const std::vector<SurfaceVpl>& vpls,
-                       const CameraSegment& segment, uint64_t streamKey) {
+                       const CameraSegment& segment, uint64_t streamKey, const std::vector<PreparedBsdf>* prepared) {
+    if (prepared && prepared->size() != vpls.size())
+        throw std::invalid_argument("sumOverSurfaceVpls: " + std::to_string(prepared->size()) +
+                                    " prepared BSDFs for " + std::to_string(vpls.size()) + " VPLs");
     Rgb sum(0.0f);
     for (uint32_t k = 0; k < vpls.size(); ++k) {
         Rng rng = vrlStream(streamKey, k);
-        sum += estimator.contribution(vpls[k], segment, rng);
+        sum += prepared ? estimator.contribution(vpls[k], (*prepared)[k], vpls[k].flux, segment, rng)
+                        : estimator.contribution(vpls[k], segment, rng);
     }
     return sum;
 }

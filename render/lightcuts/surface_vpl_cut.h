@@ -81,6 +81,7 @@
 #include "render/lightcuts/stochastic_cut.h"
 #include "render/vrl/surface_vpl_estimator.h"
 
+#include <array>
 #include <cstdint>
 #include <vector>
 
@@ -126,13 +127,14 @@ public:
     // What the estimator keeps per VPL besides the lights (for memory estimates).
     // (Per VPL: its bound and prepared BSDF; per node, two per VPL: the normal bound
     // and part (a)'s flux.)
-    static constexpr size_t kBytesPerVpl = sizeof(Rgb) + sizeof(PreparedBsdf) + 2 * (sizeof(Vec3) + sizeof(float) + sizeof(Rgb));
+    static constexpr size_t kBytesPerVpl =
+        sizeof(Rgb) + sizeof(PreparedBsdf) + 2 * (sizeof(Vec3) + sizeof(float) + sizeof(Rgb));
 
     // The medium-then-surface light along `segment` from every VPL, by a cut.
     Rgb estimate(const CameraSegment& segment, uint64_t streamKey, CutStatistics& statistics,
                  float otherLuminance = 0.0f) const;
-    // Plain shading of (b)'s surface light, every VPL against `segment` (sumOverSurfaceVpls),
-    // with the VPLs' BSDFs prepared once (atVpl_): bit for bit the same sum.
+    // Plain shading of (b)'s surface light, every VPL against `segment`: sumOverSurfaceVpls
+    // with the VPLs' BSDFs prepared once (atVpl_).
     Rgb sumAll(const CameraSegment& segment, uint64_t streamKey) const;
 
     // The bound above for node `node` and `segment`; infinite where the segment may meet the box.
@@ -176,11 +178,16 @@ private:
     std::vector<PreparedBsdf> atVpl_;
     // A node's flux as its representative carries it: I_C / F_r per channel (above).
     Rgb representativeFlux(const LightTreeNode& node) const;
+    // The point bound per channel, in double (bound() rounds it to float; importances sum it).
+    std::array<double, 3> pointBound(int32_t node, const CameraPathSurface& x, float radius) const;
 };
 
-// Plain shading: every VPL of `vpls` against `segment`, VPL k from vrlStream(streamKey, k).
+// Plain shading: every VPL of `vpls` against `segment`, VPL k from vrlStream(streamKey, k),
+// with VPL k's BSDF from (*prepared)[k] where given (prepareAt; bit for bit the same sum,
+// without preparing it on every call). Throws std::invalid_argument if the sizes differ.
 Rgb sumOverSurfaceVpls(const SurfaceVplEstimator& estimator, const std::vector<SurfaceVpl>& vpls,
-                       const CameraSegment& segment, uint64_t streamKey);
+                       const CameraSegment& segment, uint64_t streamKey,
+                       const std::vector<PreparedBsdf>* prepared = nullptr);
 // Plain shading of part (a)'s share: every VPL of `vpls` at x, the inverse square clamped at `radius`.
 Rgb sumOverSurfaceVpls(const SurfaceVplEstimator& estimator, const std::vector<SurfaceVpl>& vpls,
                        const CameraPathSurface& x, float radius);

@@ -137,7 +137,7 @@ double VrlImportance::segmentImportance(const Child& c, const SegmentQuery& q) c
     const int medium = mediumOf(c);
     double transmittance = 1.0;
     if (q.sigmaTMin > 0.0f && medium == q.medium)
-        transmittance = std::max(double(std::exp(-q.sigmaTMin * hBox)), 1e-30);
+        transmittance = std::max(double(std::exp(-q.sigmaTMin * hBox)), kTransmittanceBoundFloor);
     double importance = w * transmittance * angle / h;
     // Henyey-Greenstein media: the phase functions towards the point u of the camera
     // line in the middle of the subtended angle, relative to isotropic (4 pi)^2 f f:
@@ -195,7 +195,7 @@ double VrlImportance::surfaceImportance(const Child& c, const SurfaceQuery& q) c
     const int medium = mediumOf(c);
     double transmittance = 1.0;
     if (medium >= 0 && medium == q.medium && q.reflectsOnly && !q.changesMedium && convex_[size_t(medium)])
-        transmittance = std::max(std::exp(-double(sigmaTMin_[size_t(medium)]) * dBox), 1e-30);
+        transmittance = std::max(std::exp(-double(sigmaTMin_[size_t(medium)]) * dBox), kTransmittanceBoundFloor);
     // A single VRL in an anisotropic medium: its phase function towards x (4 pi f_V).
     double phase = 1.0;
     const int32_t node = nodeOf(c);

@@ -34,7 +34,7 @@ float HomogeneousMedium::freeFlightPdf(float t) const {
 
 Rgb HomogeneousMedium::transmittanceBound(double distance) const {
     const auto channel = [distance](float sigmaT) {
-        return float(std::max(std::exp(-double(sigmaT) * std::max(distance, 0.0)), 1e-30));
+        return float(std::max(std::exp(-double(sigmaT) * std::max(distance, 0.0)), kTransmittanceBoundFloor));
     };
     return {channel(sigmaT_.x), channel(sigmaT_.y), channel(sigmaT_.z)};
 }

@@ -22,6 +22,10 @@ struct FreeFlightSample {
     Rgb weight;      // multiply the path throughput by this (sigma_s T / pdf, or T / P)
 };
 
+// The floor of transmittance bounds and importances (transmittanceBound, vrl_importance.h):
+// far below any estimate a render keeps, far above the smallest double.
+inline constexpr double kTransmittanceBoundFloor = 1e-30;
+
 class HomogeneousMedium {
 public:
     // Throws std::invalid_argument for negative or non-finite coefficients.
@@ -43,8 +47,8 @@ public:
 
     Rgb transmittance(float distance) const;
     // An upper bound of transmittance over every path of length >= distance, for
-    // cluster bounds: floored at 1e-30 per channel, so that a bound's product of
-    // factors does not underflow to 0 where the estimate it bounds is a denormal.
+    // cluster bounds: floored at kTransmittanceBoundFloor per channel, so that a bound's
+    // product of factors does not underflow to 0 where the estimate it bounds is a denormal.
     Rgb transmittanceBound(double distance) const;
     // Samples a collision distance along [0, tMax) (tMax may be infinite) from two uniforms.
     FreeFlightSample sampleFreeFlight(float tMax, float uChannel, float uDistance) const;

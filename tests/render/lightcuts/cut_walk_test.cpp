@@ -160,10 +160,10 @@ double relativeDifference(const Rgb& a, const Rgb& b) {
     return worst;
 }
 
-CutSettings settingsFor(float threshold) {
+CutSettings settingsFor(float threshold, uint32_t maxCutSize = 1u << 30) {
     CutSettings s;
     s.errorThreshold = threshold;
-    s.maxCutSize = 1u << 30;
+    s.maxCutSize = maxCutSize;
     return s;
 }
 
@@ -201,9 +201,10 @@ TEST(CutWalk, CrossedNodesPassTheirRepresentativesEstimateOn) {
 // Walks with visitors a and b at `threshold` and expects the same bits, the same
 // nodes evaluated in the same order and the same #Eval; their statistics in sa, sb.
 template <class A, class B>
-void expectSameWalk(const LightTree& tree, float threshold, A& a, B& b, CutStatistics& sa, CutStatistics& sb) {
-    const Rgb ta = walkCut(tree, settingsFor(threshold), sa, a);
-    const Rgb tb = walkCut(tree, settingsFor(threshold), sb, b);
+void expectSameWalk(const LightTree& tree, float threshold, A& a, B& b, CutStatistics& sa, CutStatistics& sb,
+                    uint32_t maxCutSize = 1u << 30) {
+    const Rgb ta = walkCut(tree, settingsFor(threshold, maxCutSize), sa, a);
+    const Rgb tb = walkCut(tree, settingsFor(threshold, maxCutSize), sb, b);
     EXPECT_EQ(ta.x, tb.x);
     EXPECT_EQ(ta.y, tb.y);
     EXPECT_EQ(ta.z, tb.z);
@@ -296,6 +297,32 @@ TEST(CutWalk, DeferredBoundsKeepTheCutAndSkipTightBoundsOfNodesNotRefined) {
                 EXPECT_GE(deferred.tightBounds, size_t(refinements) - st.intersected);
                 if (threshold >= 0.02f) {
                     EXPECT_LT(deferred.tightBounds, size_t(st.boundedEstimates));
+                }
+            }
+}
+
+// The same under maxCutSize: the cap stops the walk after the same refinements, since
+// the deferred walk refines the same nodes in the same order (above). Caps that stop
+// the walk before the threshold does, with and without crossed nodes.
+TEST(CutWalk, DeferredBoundsKeepTheCutUnderMaxCutSize) {
+    const LightTree tree = LightTree::build(randomVrls(3000, 6));
+    for (const int cross : {0, 13})
+        for (const uint32_t cap : {2u, 8u, 64u, 333u})
+            for (const float threshold : {0.0f, 0.002f}) {
+                SCOPED_TRACE(testing::Message() << "cross " << cross << " cap " << cap << " e " << threshold);
+                Synthetic tightEverywhere{tree, cross, 1.5f};
+                SyntheticDeferred deferred{tree, cross, 1.5f};
+                CutStatistics st, sd;
+                expectSameWalk(tree, threshold, tightEverywhere, deferred, st, sd, cap);
+                EXPECT_EQ(st.cutSize, sd.cutSize);
+                EXPECT_EQ(st.intersected, sd.intersected);
+                EXPECT_EQ(st.boundedEstimates, sd.boundedEstimates);
+                CutStatistics uncapped;
+                Synthetic free{tree, cross, 1.5f};
+                walkCut(tree, settingsFor(threshold), uncapped, free);
+                EXPECT_LT(st.cutSize, uncapped.cutSize) << "the cap must stop the walk";
+                if (cross == 0) {
+                    EXPECT_EQ(sd.cutSize, cap);
                 }
             }
 }

@@ -35,6 +35,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <limits>
 
 namespace vrl {
 namespace {
@@ -228,6 +229,38 @@ TEST(StochasticCut, ZeroImportanceChildrenTakeNoSlot) {
         }
         EXPECT_NEAR(sum, double(cut.size()), 1e-9 * double(cut.size()));
     }
+}
+
+// The cut's skip rule (neverTaken) and the descent's probabilities (leftProbability)
+// agree: over pairs of importances from {0, -0, a denormal, 1, 1e300, inf, NaN}, a
+// child the cut skips has probability exactly 0 and its sibling 1; and a child of
+// importance 0 that leftProbability gives probability 0 (its ratio branch) is skipped.
+TEST(StochasticCut, SkippedChildrenAreTheOnesNoDescentTakes) {
+    Rng rng(12, 0);
+    const LightTree tree = LightTree::build(randomVrls(rng, 8), LightTreeSettings{4, 12});
+    const LightTreeNode& root = tree.nodes()[tree.root()];
+    const double values[] = {0.0, -0.0, 4.9e-324, 1.0, 1e300, std::numeric_limits<double>::infinity(),
+                             std::numeric_limits<double>::quiet_NaN()};
+    int skipped = 0;
+    for (const double l : values)
+        for (const double r : values) {
+            const ChildImportances c{{root.left, root.right}, {l, r}};
+            const double pl = leftProbability(c, tree);
+            const double p[2] = {pl, 1.0 - pl};
+            for (int k = 0; k < 2; ++k) {
+                SCOPED_TRACE(testing::Message() << "importances " << l << ", " << r << ", child " << k);
+                if (neverTaken(c, k)) {
+                    ++skipped;
+                    EXPECT_EQ(p[k], 0.0);
+                    EXPECT_EQ(p[1 - k], 1.0);
+                }
+                const double sum = c.value[0] + c.value[1];
+                if (c.value[k] == 0.0 && sum > 0.0 && std::isfinite(sum)) {
+                    EXPECT_TRUE(neverTaken(c, k));
+                }
+            }
+        }
+    EXPECT_EQ(skipped, 2 * 2 * 3) << "a zero beside the denormal, 1 and 1e300, either side";
 }
 
 struct MeanAndError {
