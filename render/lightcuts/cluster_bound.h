@@ -21,7 +21,7 @@
 // medium whose boundary is convex, holding the node's VRLs,
 // T(u) T_r(w) = exp(-sigma_t (u + w)) and u + w >= |origin - v| >= d_o, the
 // distance from the segment's origin to the box (>= h_min), so it is bounded by
-// T(d_o) (floored at 1e-30 against underflow); elsewhere by 1, as is
+// T(d_o) (floored at kTransmittanceBoundFloor against underflow); elsewhere by 1, as is
 // visibility. A line through the node's box (h_min = 0) gives an infinite
 // bound: the node is always refined.
 //

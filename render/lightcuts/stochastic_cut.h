@@ -7,7 +7,7 @@
 // leaves. The cut's nodes and the children left out of it (below) partition the
 // leaves, so the total is the sum over the cut's nodes of each node's own sum,
 // whatever rule chose the cut. A child whose importance is 0 while its sibling's
-// is positive is left out of the cut: its contribution is 0 (below), and a descent
+// is positive and finite is left out of the cut (neverTaken): its contribution is 0 (below), and a descent
 // through its parent would never take it anyway; the slot goes to a node that can
 // contribute.
 //

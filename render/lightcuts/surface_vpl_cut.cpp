@@ -257,7 +257,9 @@ Rgb SurfaceVplLightcutsEstimator::estimate(const CameraSegment& segment, uint64_
 }
 
 Rgb SurfaceVplLightcutsEstimator::sumAll(const CameraSegment& segment, uint64_t streamKey) const {
-    return sumOverSurfaceVpls(estimator_, lights_.vpls, segment, streamKey, &atVpl_);
+    // atVpl_ holds one BSDF per VPL where the estimator has a tree (the constructor), else none.
+    const bool prepared = atVpl_.size() == lights_.vpls.size();
+    return sumOverSurfaceVpls(estimator_, lights_.vpls, segment, streamKey, prepared ? &atVpl_ : nullptr);
 }
 
 Rgb sumOverSurfaceVpls(const SurfaceVplEstimator& estimator, const std::vector<SurfaceVpl>& vpls,

@@ -30,7 +30,7 @@
 // shape that bounds no medium (the proxy's medium, else -1) and that medium's
 // boundary is convex, u -> y stays in it, so T_m(t) T_r = exp(-sigma_t (t + r))
 // with t + r >= |o - y| >= d_o, the distance from the segment's origin o to B:
-// the bound takes the factor T(d_o) (floored at 1e-30 against underflow).
+// the bound takes the factor T(d_o) (floored at kTransmittanceBoundFloor against underflow).
 // The cosine at y, where every VPL of the node has a Lambertian bound and their
 // geometric normals n_k lie within eps of one axis a (|n_k - a| <= eps: a floor, a
 // wall): for Lambertian-bounded models f_s = F_k |w.n_g| at most (the importance-mode
@@ -69,7 +69,7 @@
 // over the representative's weighting as above: at most I_C c_y F_x T / max(d, R)^2.
 // Only the VPLs part (a) takes (reflectsBroadly) contribute; the others give 0, so
 // I_C there sums the I_k of those alone (0 for a node of narrow-lobe VPLs: beside a
-// sibling of positive bound such a node takes no slot of the stochastic cut and no
+// sibling of positive, finite bound such a node takes no slot of the stochastic cut and no
 // descent takes it (stochastic_cut.h); only where every node is 0 is one drawn, and it gives 0). The clamp makes every bound finite, even for a box that holds x. Part (a) takes
 // this bound as the importance of a stochastic cut (sample, below): VPLs are drawn
 // in proportion to it, so a draw's estimate / probability stays near the node's
@@ -134,7 +134,7 @@ public:
     Rgb estimate(const CameraSegment& segment, uint64_t streamKey, CutStatistics& statistics,
                  float otherLuminance = 0.0f) const;
     // Plain shading of (b)'s surface light, every VPL against `segment`: sumOverSurfaceVpls
-    // with the VPLs' BSDFs prepared once (atVpl_).
+    // with the VPLs' BSDFs prepared once (atVpl_; without a tree, prepared on each call).
     Rgb sumAll(const CameraSegment& segment, uint64_t streamKey) const;
 
     // The bound above for node `node` and `segment`; infinite where the segment may meet the box.

@@ -1,6 +1,7 @@
 #include "render/lightcuts/vrl_importance.h"
 
 #include "render/core/distance.h"
+#include "render/media/homogeneous_medium.h"
 #include "render/scene/scene.h"
 
 #include <algorithm>

@@ -24,7 +24,7 @@
 // else 1 — an inner node does not know its VRLs' directions); HG is positive
 // everywhere, so the factor never makes an importance 0.
 // Zero only if Phi L sigma_s is 0 (then every VRL's estimate is 0): T_r is
-// floored at 1e-30 so that distance never makes an importance 0.
+// floored at kTransmittanceBoundFloor (1e-30) so that distance never makes an importance 0.
 //
 // Surface (c) (vrl_surface_estimator.h integrates Phi sigma_s f_p f_s |cos| T_r V / r^2
 // over the VRL):

@@ -318,8 +318,8 @@ TEST(CutWalk, DeferredBoundsKeepTheCutUnderMaxCutSize) {
                 EXPECT_EQ(st.intersected, sd.intersected);
                 EXPECT_EQ(st.boundedEstimates, sd.boundedEstimates);
                 CutStatistics uncapped;
-                Synthetic free{tree, cross, 1.5f};
-                walkCut(tree, settingsFor(threshold), uncapped, free);
+                Synthetic uncappedWalk{tree, cross, 1.5f};
+                walkCut(tree, settingsFor(threshold), uncapped, uncappedWalk);
                 EXPECT_LT(st.cutSize, uncapped.cutSize) << "the cap must stop the walk";
                 if (cross == 0) {
                     EXPECT_EQ(sd.cutSize, cap);

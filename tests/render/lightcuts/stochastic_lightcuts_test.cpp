@@ -261,6 +261,26 @@ TEST(StochasticCut, SkippedChildrenAreTheOnesNoDescentTakes) {
             }
         }
     EXPECT_EQ(skipped, 2 * 2 * 3) << "a zero beside the denormal, 1 and 1e300, either side";
+    // In a cut: a 0 beside an infinite sibling keeps its slot (the descent falls back to
+    // flux x length there), so every VRL of positive flux x length stays reachable and the
+    // probabilities sum to K.
+    const LightTree big = LightTree::build(randomVrls(rng, 500), LightTreeSettings{64, 12});
+    const auto zeroBesideInfinite = [&](int32_t n) {
+        const LightTreeNode& node = big.nodes()[n];
+        return ChildImportances{{node.left, node.right}, {0.0, std::numeric_limits<double>::infinity()}};
+    };
+    for (const uint32_t cutSize : {4u, 32u}) {
+        const std::vector<double> p = stochasticLeafProbabilities(big, cutSize, zeroBesideInfinite);
+        double sum = 0.0;
+        for (uint32_t k = 0; k < p.size(); ++k) {
+            sum += p[k];
+            const Vrl& v = big.vrls()[k];
+            if (maxComponent(v.flux) > 0.0f && v.length > 0.0f) {
+                EXPECT_GT(p[k], 0.0) << "VRL " << k << " unreachable at K = " << cutSize;
+            }
+        }
+        EXPECT_NEAR(sum, double(cutSize), 1e-9 * cutSize);
+    }
 }
 
 struct MeanAndError {

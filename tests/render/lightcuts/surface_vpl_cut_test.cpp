@@ -56,6 +56,7 @@
 #include <cmath>
 #include <cstdio>
 #include <limits>
+#include <stdexcept>
 #include <string>
 #include <utility>
 #include <vector>
@@ -396,6 +397,28 @@ TEST(SurfaceVplCut, ZeroThresholdIsThePlainSum) {
         std::printf("%s: %zu VPLs, %zu segments, mean cut %.0f, largest relative difference %.2e\n", m.name, n,
                     setup.segments.size(), double(cutSizes) / setup.segments.size(), worst);
     }
+}
+
+// Plain VPL shading with the BSDFs prepared once (sumAll, as `--method vrl` runs it) is
+// bit for bit the sum that prepares each VPL's BSDF on every call; a prepared list of
+// the wrong size is refused.
+TEST(SurfaceVplCut, PlainSumWithPreparedBsdfsIsBitIdentical) {
+    const RoomCase setup = roomSetup(kRoomMedia[0], true);
+    const SurfaceVplEstimator estimator(*setup.scene);
+    const SurfaceVplLightcutsEstimator cut(*setup.scene, setup.lights, estimator, CutSettings{});
+    size_t nonZero = 0;
+    for (size_t j = 0; j < setup.segments.size(); j += 7) {
+        const Rgb plain = sumOverSurfaceVpls(estimator, setup.lights.vpls, setup.segments[j], setup.keys[j]);
+        const Rgb prepared = cut.sumAll(setup.segments[j], setup.keys[j]);
+        EXPECT_EQ(plain.x, prepared.x) << "segment " << j;
+        EXPECT_EQ(plain.y, prepared.y) << "segment " << j;
+        EXPECT_EQ(plain.z, prepared.z) << "segment " << j;
+        nonZero += !isBlack(plain);
+    }
+    EXPECT_GT(nonZero, 20u);
+    const std::vector<PreparedBsdf> tooFew(setup.lights.vpls.size() - 1);
+    EXPECT_THROW(sumOverSurfaceVpls(estimator, setup.lights.vpls, setup.segments[0], setup.keys[0], &tooFew),
+                 std::invalid_argument);
 }
 
 TEST(SurfaceVplCut, ThresholdBoundsTheRelativeErrorOfTheImageSum) {
