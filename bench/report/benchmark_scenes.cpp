@@ -52,7 +52,7 @@ std::vector<MethodRun> sweep(bool quick) {
     // At 320x180 (57,600 pixels) on 2 cores, bathroom: about 0.5 to 20 s a run (the
     // paper scenes up to 1.6x that). The whole-image runs are a quarter of the spp
     // they had when the full report took 62 min (its limit is 45): the whole image is
-    // mostly parts (a) and (b), path-sampled alike by every virtual-light method, so
+    // mostly parts (a) and (b), sampled alike by the virtual-light methods, so
     // fewer samples move every curve alike and keep them above the noise rule's floor.
     // (Since part (b)'s surface light comes from surface VPLs in plain VRLs and VRL
     // Lightcuts, their whole-image runs err x0.3-1.0 less, and four veach-lamp runs

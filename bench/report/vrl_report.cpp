@@ -876,7 +876,8 @@ std::string verdict(const std::vector<RunResult>& results, const std::string& na
         v << "VRL Lightcuts does **not** reach 10× less time than plain VRLs at equal error: at most "
           << fmt(*bestSpeedup) << "×. Per pixel it evaluates #Eval = " << cost
           << " VRLs over its camera segments (plain VRLs evaluate all N on each)"
-          << (multipleOnly ? "" : "; part (a) is path-sampled alike in both and costs both the same time, and both take part (b)'s "
+          << (multipleOnly ? "" : "; part (a) is sampled alike in both (path tracing, and the surface VPLs of broad lobes drawn by a "
+                                 "small stochastic cut) and costs both the same time, and both take part (b)'s "
                                  "surface light from surface VPLs (plain VRLs from every VPL, VRL Lightcuts by a cut)")
           << ". ";
     }
@@ -1104,7 +1105,8 @@ void writeSummary(const fs::path& path, const Options& o, const std::vector<Scen
           "noise is part of the whole image's error, and the spp grow with N along each curve) and parts (c) and (d) "
           "with their VRLs: plain VRLs and VRL Lightcuts (relative error threshold e, 0.02 unless stated) once per "
           "pixel, with part (b)'s non-Dirac surface light from surface VPLs of the same light paths (every VPL or a "
-          "cut, once per pixel), stochastic VRL Lightcuts at every sample (K VRLs per camera segment and surface "
+          "cut, once per pixel) and part (a)'s light of broad lobes from the same VPLs (two drawn by a stochastic "
+          "cut per sample), stochastic VRL Lightcuts at every sample (K VRLs per camera segment and surface "
           "point). VPL "
           "Lightcuts path-samples part (c) too and gathers (d) without clamping, as in the paper, at "
        << kDefaultVplDistanceSamples
