@@ -69,7 +69,8 @@ inline double leftProbability(const ChildImportances& c, const LightTree& tree) 
 // Whether a descent from the parent never takes child k: its importance is 0 beside a
 // positive, finite sibling, where leftProbability gives it probability 0 (the ratio
 // branch). The cut gives such a child no slot, since its contribution is 0 (the
-// importance's contract): the cut and the descent follow this one rule.
+// importance's contract); the descent reaches the same children through leftProbability,
+// and StochasticCut.SkippedChildrenAreTheOnesNoDescentTakes keeps the two in step.
 inline bool neverTaken(const ChildImportances& c, int k) {
     return c.value[k] == 0.0 && c.value[1 - k] > 0.0 && std::isfinite(c.value[1 - k]);
 }
