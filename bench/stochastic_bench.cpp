@@ -33,13 +33,19 @@
 // Timings are wall-clock, one run each, on whatever cores TBB gets: compare
 // ratios within one run, not seconds.
 #include "bench/bench_lights.h"
+#include "bench/stochastic_ceiling.h"
 #include "render/core/timing.h"
 #include "render/image/image_metrics.h"
 #include "render/integrators/transport_integrator.h"
 #include "render/lightcuts/light_tree.h"
+#include "render/lightcuts/stochastic_cut.h"
+#include "render/lightcuts/vrl_importance.h"
 #include "render/scene/scene.h"
+#include "render/scene_io/medium_fill.h"
 #include "render/scene_io/mitsuba/mitsuba_parser.h"
+#include "render/vrl/camera_segment.h"
 #include "render/vrl/light_tracer.h"
+#include "render/vrl/vrl_estimator.h"
 
 #include <CLI/CLI.hpp>
 #include <tbb/parallel_for.h>
@@ -48,6 +54,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <mutex>
 #include <stdexcept>
 
 using namespace vrl;
@@ -97,6 +104,121 @@ Shading shade(const Scene& scene, const VrlSet& vrls, const LightTree& tree, Met
     out.evaluated = double(evaluated.load()) / samples;
     out.importances = double(importances.load()) / samples;
     return out;
+}
+
+// --ceiling M: the ceiling of any stochastic cut's saving over plain VRLs
+// (stochastic_ceiling.h), and where vrl-stochastic's K-node cut stands under it,
+// from the moments of every VRL's one-sample estimate for each shaded pixel's camera
+// segments, each estimated from M independent (u, v) samples. The deviations' sqrt
+// is biased low by about 1/(2M) alike in the ceiling's numerator and denominator.
+// Only (u, v) noise is counted: the cut's cost per estimate (importances) and any
+// camera jitter come on top.
+struct Ceiling {
+    double ceiling = 0.0;     // N / N_eff over the image
+    double cutGain = 0.0;     // the same ratio for vrl-stochastic's cut with its own descents (predicted)
+    double idealGain = 0.0;   // ... with ideal descents under the same cut nodes
+    double leafGain = 0.0;    // ... with each cut node drawing its VRLs by their own (leaf) importances
+    double plainEstimates = 0.0;  // N x camera segments per shaded pixel
+    double seconds = 0.0;
+};
+
+Ceiling stochasticCeiling(const Scene& scene, const VrlSet& vrls, const LightTree& tree, int maxDepth, int samples,
+                          int stride, uint32_t cutSize) {
+    const VrlEstimator estimator(scene, 1);
+    const VrlImportance importance(scene, tree);
+    const PerspectiveCamera& camera = scene.camera();
+    const size_t n = vrls.vrls.size();
+    std::vector<VrlEstimator::Query> queries(n);
+    for (size_t i = 0; i < n; ++i) queries[i] = {&vrls.vrls[i], vrls.vrls[i].flux, uint32_t(i)};
+    struct Sums {
+        bench::CeilingSums ceiling;
+        double cut = 0.0, ideal = 0.0, leaf = 0.0;  // sum w K V of the cut, three ways
+        uint64_t pixels = 0, segments = 0;
+    };
+    std::mutex mutex;
+    Sums total;
+    const auto start = std::chrono::steady_clock::now();
+    tbb::parallel_for(0, (camera.height() + stride - 1) / stride, [&](int row) {
+        const int y = row * stride;
+        std::vector<Rgb> out(n);
+        std::vector<double> sum(n), squares(n);
+        std::vector<bench::EstimateMoments> moments(n), leaves;
+        std::vector<double> descent, own;
+        struct Entry {
+            int32_t node;
+            double probability, importance;  // the descent's, and the node's own (from its parent)
+        };
+        std::vector<Entry> stack;
+        Sums rowSums;
+        for (int x = 0; x < camera.width(); x += stride) {
+            Rng rng(1, uint64_t(y) * camera.width() + x);
+            const auto segments =
+                cameraSegments(scene, camera.generateRay(x + 0.5f, y + 0.5f), scene.cameraMedium(), &rng, maxDepth);
+            Sums pixel;
+            double pixelMean = 0.0;
+            for (size_t g = 0; g < segments.size(); ++g) {
+                std::fill(sum.begin(), sum.end(), 0.0);
+                std::fill(squares.begin(), squares.end(), 0.0);
+                for (int j = 0; j < samples; ++j) {
+                    const uint64_t key = ((uint64_t(y) * camera.width() + x) * 64 + g) * 1024 + uint64_t(j);
+                    estimator.contributions(queries.data(), n, segments[g], key, out.data());
+                    for (size_t i = 0; i < n; ++i) {
+                        const double l = luminance(out[i]);
+                        sum[i] += l, squares[i] += l * l;
+                    }
+                }
+                for (size_t i = 0; i < n; ++i) {
+                    moments[i] = {sum[i] / samples, squares[i] / samples};
+                    pixelMean += moments[i].mean;
+                }
+                pixel.ceiling.add(moments, 1.0);
+                // vrl-stochastic's cut for this segment; per cut node, its VRLs' descent
+                // probabilities and their own importances (from their parents' pairs).
+                const VrlImportance::SegmentQuery query = importance.prepare(segments[g]);
+                const auto childrenOf = [&](int32_t node) { return importance.children(node, query); };
+                const std::vector<int32_t> cut = stochasticCut(tree, cutSize, childrenOf);
+                const double k = double(cut.size());
+                for (const int32_t c : cut) {
+                    leaves.clear(), descent.clear(), own.clear();
+                    stack.assign(1, {c, 1.0, 1.0});
+                    while (!stack.empty()) {
+                        const auto [node, q, value] = stack.back();
+                        stack.pop_back();
+                        if (isLeafNode(tree, node)) {
+                            leaves.push_back(moments[size_t(node)]), descent.push_back(q), own.push_back(value);
+                            continue;
+                        }
+                        const ChildImportances children = childrenOf(node);
+                        const double pl = leftProbability(children, tree);
+                        stack.push_back({children.node[0], q * pl, children.value[0]});
+                        stack.push_back({children.node[1], q * (1.0 - pl), children.value[1]});
+                    }
+                    pixel.cut += k * bench::nodeVariance(leaves, descent);
+                    pixel.ideal += k * bench::idealNodeVariance(leaves);
+                    double ownSum = 0.0;
+                    for (const double v : own) ownSum += v;
+                    for (double& v : own) v = ownSum > 0.0 ? v / ownSum : 0.0;
+                    pixel.leaf += k * bench::nodeVariance(leaves, own);
+                }
+            }
+            const double weight = 1.0 / (pixelMean * pixelMean + kMetricEpsilon);
+            rowSums.ceiling.noise += weight * pixel.ceiling.noise;
+            rowSums.ceiling.noiseSum2 += weight * pixel.ceiling.noiseSum2;
+            rowSums.cut += weight * pixel.cut, rowSums.ideal += weight * pixel.ideal, rowSums.leaf += weight * pixel.leaf;
+            ++rowSums.pixels, rowSums.segments += segments.size();
+        }
+        const std::lock_guard lock(mutex);
+        total.ceiling.noise += rowSums.ceiling.noise, total.ceiling.noiseSum2 += rowSums.ceiling.noiseSum2;
+        total.cut += rowSums.cut, total.ideal += rowSums.ideal, total.leaf += rowSums.leaf;
+        total.pixels += rowSums.pixels, total.segments += rowSums.segments;
+    });
+    const auto gain = [&](double variance) { return variance > 0.0 ? double(n) * total.ceiling.noise / variance : 0.0; };
+    Ceiling c;
+    c.ceiling = total.ceiling.ceiling(n);
+    c.cutGain = gain(total.cut), c.idealGain = gain(total.ideal), c.leafGain = gain(total.leaf);
+    c.plainEstimates = total.pixels > 0 ? double(n) * double(total.segments) / double(total.pixels) : 0.0;
+    c.seconds = secondsSince(start);
+    return c;
 }
 
 Image mean(const std::vector<Image>& images) {
@@ -251,11 +373,15 @@ int main(int argc, char** argv) {
     uint64_t strideAbove = 200000;
     int stride = 4;
     std::vector<std::string> defines;
+    std::string medium;
     bool againstTruth = false;
     int maxSets = 16;
+    int ceilingSamples = 0;
     TruthOptions truth;
     app.add_option("--scene", scenePath, "Scene file (default scenes/smoke-room.xml)");
     app.add_option("-D,--define", defines, "Override a scene <default>: -D name=value (repeatable)");
+    app.add_option("--medium", medium, "Fill the scene with a homogeneous medium, as vrl render --medium does "
+                                       "(e.g. sigmaS=0.1,sigmaA=0.02)");
     app.add_option("--vrls", counts, "VRL counts to run (default 10000 100000)");
     app.add_option("--resolution", resolution, "Image size WxH (default 64x48)");
     app.add_option("--error", error, "Lightcuts error threshold (default 0.02)");
@@ -276,6 +402,10 @@ int main(int argc, char** argv) {
     app.add_option("--truth-sets", truth.sets, "--truth: reference sets, even (default 8)")->check(CLI::Range(2, 4096));
     app.add_option("--truth-cut-size", truth.cutSize, "--truth: K of the reference's vrl-stochastic (default 32)")->check(CLI::Range(1, 1 << 20));
     app.add_option("--truth-spp", truth.spp, "--truth: vrl-stochastic spp per reference set (default 32)")->check(CLI::Range(1, 1 << 20));
+    app.add_option("--ceiling", ceilingSamples,
+                   "Also print the ceiling of any stochastic cut's speed-up over plain VRLs at equal error, from M "
+                   "(u, v) samples per VRL and segment (0: off)")
+        ->check(CLI::Range(0, 1024) & !CLI::IsMember({1}));
     CLI11_PARSE(app, argc, argv);
     const bool surfacePart = part == "medium-surface";
 
@@ -289,6 +419,7 @@ int main(int argc, char** argv) {
         parseOptions.defines[d.substr(0, eq)] = d.substr(eq + 1);
     }
     SceneDescription description = parseMitsubaScene(scenePath, parseOptions);
+    if (!medium.empty()) fillWithMedium(description, parseFillMedium(medium));
     int w = 0, h = 0;
     if (std::sscanf(resolution.c_str(), "%dx%d", &w, &h) != 2 || w < 1 || h < 1) {
         std::fprintf(stderr, "bad --resolution '%s'\n", resolution.c_str());
@@ -323,17 +454,28 @@ int main(int argc, char** argv) {
         std::printf("  %-22s %9.3f s  relRMSE %.5f\n", "plain VRLs", plain.seconds, plainError);
         std::printf("  %-22s %9.3f s  relRMSE %.5f  #Eval %.0f per pixel\n", "VRL Lightcuts", cuts.seconds, cutsError,
                     cuts.evaluated);
+        Ceiling ceiling;
+        if (ceilingSamples > 0) {
+            ceiling = stochasticCeiling(*scene, vrls, tree, description.integrator.maxDepth, ceilingSamples, s,
+                                        uint32_t(cutSizes.front()));
+            std::printf("  ceiling (%d (u, v) samples per VRL, %.1f s): any stochastic cut needs >= 1/%.2f of plain's %.0f "
+                        "estimates per pixel for plain's error (N / N_eff of the VRLs' noise)\n",
+                        ceilingSamples, ceiling.seconds, ceiling.ceiling, ceiling.plainEstimates);
+            std::printf("  the K = %d cut needs 1/%.2f of them with its descents (predicted), 1/%.2f with ideal descents "
+                        "under the same nodes, 1/%.2f drawing by the VRLs' own importances\n",
+                        cutSizes.front(), ceiling.cutGain, ceiling.idealGain, ceiling.leafGain);
+        }
         for (const int cutSize : cutSizes) {
             struct Point {
                 int spp;
-                double seconds, error;
+                double seconds, error, evaluated;
             };
             std::vector<Point> points;
             for (int spp = 1; spp <= maxSpp; spp *= 2) {
                 const Shading st =
                     shade(*scene, vrls, tree, Method::Stochastic, error, cutSize, spp, s, 1, surfacePart, vrlSamples);
                 const double e = compareImages(reference, st.image).relativeRmse;
-                points.push_back({spp, st.seconds, e});
+                points.push_back({spp, st.seconds, e, st.evaluated});
                 std::printf("  vrl-stochastic K %4d %5d spp %9.3f s  relRMSE %.5f  #Eval %.1f, importances %.0f per pixel and sample\n",
                             cutSize, spp, st.seconds, e, st.evaluated, st.importances);
                 std::fflush(stdout);
@@ -368,6 +510,17 @@ int main(int argc, char** argv) {
             const double tCuts = timeFor(cutsError, extrapolated);
             std::printf("  st_eq_lc:    %.3f s%s to reach the Lightcuts error: VRL Lightcuts take %.2fx that time\n", tCuts,
                         extrapolated ? "*" : "", cuts.seconds / tCuts);
+            if (ceilingSamples > 0 && ceiling.plainEstimates > 0.0 && points.back().evaluated > 0.0) {
+                // At equal error the cut spends >= plain's estimates / ceiling, each at its own
+                // measured cost (importances included): plain's time over its time is at most this.
+                const Point& last = points.back();
+                const double stochasticPerEstimate = last.seconds / (last.evaluated * last.spp);
+                const double plainPerEstimate = plain.seconds / ceiling.plainEstimates;
+                std::printf("  ceiling:     an estimate costs %.2fx plain's, so at equal error this cut is at most %.2fx "
+                            "faster than plain VRLs (an ideal importance at this cost)\n",
+                            stochasticPerEstimate / plainPerEstimate,
+                            ceiling.ceiling * plainPerEstimate / stochasticPerEstimate);
+            }
         }
         std::fflush(stdout);
     }
