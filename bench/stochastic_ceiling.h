@@ -17,17 +17,27 @@
 // With Cauchy-Schwarz over the K nodes, K sum_n V_n >= (sum_n sqrt(V_n))^2 >=
 // (sum_i s_i)^2, whatever the cut, the partition and the probabilities. M samples of
 // the cut (K M estimates) have variance sum_n V_n / M; matching plain's sum_i s_i^2
-// takes K M >= (sum_i s_i)^2 / sum_i s_i^2, so the cut saves at most
-//   N sum_i s_i^2 / (sum_i s_i)^2 = N / N_eff                                (ceiling)
+// takes K M >= (sum_i s_i)^2 / sum_i s_i^2, so on one segment the cut saves at most
+//   N sum_i s_i^2 / (sum_i s_i)^2 = N / N_eff
 // of plain's N estimates, N_eff being the participation ratio of the VRLs' noise
-// (N when every VRL is equally noisy, 1 when one VRL holds all of it). Each
-// stochastic estimate costs at least what a plain one does (the same kernel,
-// plus importances), so N / N_eff also caps the speed-up in time. It holds for
-// (u, v) samples too: V samples per drawn VRL divide each s_i^2 by V and multiply
-// the cost by V.
-// Over an image, the error that relRMSE measures weights pixel p by
-// w_p = 1 / (mean_p^2 + eps) and every pixel gets the same M: the ceiling is
-// N sum_p w_p sum_i s_i^2 / sum_p w_p (sum_i s_i)^2 (CeilingSums).
+// (N when every VRL is equally noisy, 1 when one VRL holds all of it). In time the
+// saving is smaller by the ratio of costs per estimate: vrl-stochastic runs plain's
+// kernel for each drawn VRL plus its importances (measured by the bench).
+// Over an image, relRMSE weights pixel p's squared error by w_p = 1 / (ref_p^2 + eps),
+// and a pixel's camera segments are independent. If the cut spends n_g = K_g M_g
+// estimates on segment g (of pixel p), the image's weighted variance is at least
+// sum_g w_p S_g^2 / n_g (S_g = sum_i s_i on g). Over budgets n_g of total B this is
+// smallest for n_g ~ sqrt(w_p) S_g (Cauchy-Schwarz): (sum_g sqrt(w_p) S_g)^2 / B.
+// Plain VRLs spend N per segment, N G in all (G segments), for sum_g w_p P_g
+// (P_g = sum_i s_i^2 on g). So any cut that matches plain's error saves at most
+//   N G sum_g w_p P_g / (sum_g sqrt(w_p) S_g)^2                          (ceiling)
+// and one with the same K M on every segment, as vrl-stochastic, at most
+//   N sum_g w_p P_g / sum_g w_p S_g^2                                      (uniformCeiling)
+// (no larger than the first, by Cauchy-Schwarz). Assumed: each drawn VRL's estimate
+// is plain's one-sample estimator (or an average of V of them at V times the cost:
+// the same bound per (u, v) sample), and each segment is fixed. A camera path with
+// a random specular choice (glass) is not: M samples of a method average that
+// choice, plain's one path does not, so such pixels are left out of the sums.
 #pragma once
 
 #include <algorithm>
@@ -64,20 +74,31 @@ inline double idealNodeVariance(std::span<const EstimateMoments> leaves) {
     return a * a - mean * mean;
 }
 
-// Per-segment terms summed over a region (an image), each with its pixel's weight.
+// The per-segment terms summed over an image, each segment with its pixel's weight.
 struct CeilingSums {
-    double noise = 0.0;      // sum w sum_i s_i^2: plain's variance
-    double noiseSum2 = 0.0;  // sum w (sum_i s_i)^2: K M times the least variance of any cut
+    double plain = 0.0;    // sum_g w P_g: plain's weighted variance
+    double root = 0.0;     // sum_g sqrt(w) S_g
+    double uniform = 0.0;  // sum_g w S_g^2
+    double segments = 0.0;  // G
     void add(std::span<const EstimateMoments> vrls, double weight) {
-        double s2 = 0.0, s = 0.0;
+        double p = 0.0, deviations = 0.0;
         for (const EstimateMoments& m : vrls) {
             const double d = m.deviation();
-            s2 += d * d, s += d;
+            p += d * d, deviations += d;
         }
-        noise += weight * s2, noiseSum2 += weight * s * s;
+        plain += weight * p, root += std::sqrt(weight) * deviations, uniform += weight * deviations * deviations;
+        segments += 1.0;
     }
-    // N / N_eff: the most plain estimates one stochastic estimate can stand for.
-    double ceiling(size_t vrlCount) const { return noiseSum2 > 0.0 ? double(vrlCount) * noise / noiseSum2 : 0.0; }
+    void add(const CeilingSums& o) {
+        plain += o.plain, root += o.root, uniform += o.uniform, segments += o.segments;
+    }
+    // The most plain estimates one estimate of any stochastic cut can stand for (N
+    // VRLs per segment), with its estimates spread over the segments at will.
+    double ceiling(size_t vrlCount) const {
+        return root > 0.0 ? double(vrlCount) * segments * plain / (root * root) : 0.0;
+    }
+    // The same with K M estimates on every segment.
+    double uniformCeiling(size_t vrlCount) const { return uniform > 0.0 ? double(vrlCount) * plain / uniform : 0.0; }
 };
 
 }  // namespace vrl::bench

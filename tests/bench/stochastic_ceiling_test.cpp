@@ -24,8 +24,7 @@ std::vector<TwoPoint> randomEstimates(std::mt19937& rng, size_t n) {
     std::vector<TwoPoint> out(n);
     for (auto& e : out) {
         const double mean = std::pow(u(rng), 3.0), spread = mean * 2.0 * u(rng);
-        e = {mean - 0.5 * spread, mean + 0.5 * spread};
-        if (e.low < 0.0) e = {0.0, 2.0 * mean};
+        e = {mean - 0.5 * spread, mean + 0.5 * spread};  // spread <= 2 mean: both >= 0
     }
     return out;
 }
@@ -87,8 +86,8 @@ TEST(StochasticCeiling, NodeVarianceIsInfiniteWhenAContributingVrlCannotBeDrawn)
 }
 
 TEST(StochasticCeiling, NoCutBeatsTheCeiling) {
-    // K sum_n V_n >= (sum_i s_i)^2 for every partition into K nodes and all probabilities,
-    // with equality for one VRL per node (the cut is plain VRLs).
+    // K sum_n V_n >= (sum_i s_i)^2 for every partition into K nodes and all probabilities;
+    // one VRL per node is plain VRLs, whose variance is sum_i s_i^2.
     std::mt19937 rng(3);
     for (int trial = 0; trial < 300; ++trial) {
         const size_t n = 2 + size_t(trial % 40);
@@ -115,18 +114,58 @@ TEST(StochasticCeiling, NoCutBeatsTheCeiling) {
     }
 }
 
-TEST(StochasticCeiling, CeilingIsNOverTheParticipationRatio) {
+TEST(StochasticCeiling, CeilingsOfOneSegment) {
     CeilingSums equal;
     equal.add(std::vector<EstimateMoments>(50, {1.0, 2.0}), 1.0);
     EXPECT_NEAR(equal.ceiling(50), 1.0, 1e-12);  // equally noisy VRLs: no cut saves anything
+    EXPECT_NEAR(equal.uniformCeiling(50), 1.0, 1e-12);
     CeilingSums one;
     std::vector<EstimateMoments> m(50, {1.0, 1.0});  // exact estimates...
     m[7] = {1.0, 5.0};                                // ...but one
     one.add(m, 1.0);
     EXPECT_NEAR(one.ceiling(50), 50.0, 1e-12);  // one noisy VRL: up to N
-    // Weights: two regions, each counted by its weight.
-    CeilingSums both;
-    both.add(std::vector<EstimateMoments>(50, {1.0, 2.0}), 1.0);
-    both.add(m, 3.0);
-    EXPECT_NEAR(both.ceiling(50), 50.0 * (50.0 + 3.0 * 4.0) / (2500.0 + 3.0 * 4.0), 1e-12);
+    EXPECT_NEAR(one.uniformCeiling(50), 50.0, 1e-12);
+}
+
+TEST(StochasticCeiling, NoAllocationOverSegmentsBeatsTheCeiling) {
+    // Segments of different noise and weight. Spending n_g estimates on segment g gives at
+    // least sum_g w_g S_g^2 / n_g; scaled to plain's variance sum_g w_g P_g, every
+    // allocation spends at least N G / ceiling, and the same n on every segment at least
+    // N G / uniformCeiling. The allocation n_g ~ sqrt(w_g) S_g attains the ceiling.
+    std::mt19937 rng(5);
+    std::uniform_real_distribution<double> u(0.0, 1.0);
+    for (int trial = 0; trial < 200; ++trial) {
+        const size_t n = 30, segmentCount = 1 + size_t(trial % 6);
+        CeilingSums sums;
+        std::vector<double> weight, s, s2;
+        for (size_t g = 0; g < segmentCount; ++g) {
+            auto m = momentsOf(randomEstimates(rng, n));
+            if (trial % 3 == 0 && g == 0)  // one segment whose noise is all in one VRL
+                for (size_t i = 1; i < n; ++i) m[i].second = m[i].mean * m[i].mean;
+            weight.push_back(0.1 + 10.0 * u(rng));
+            sums.add(m, weight.back());
+            double a = 0.0, b = 0.0;
+            for (const auto& e : m) a += e.deviation(), b += e.deviation() * e.deviation();
+            s.push_back(a), s2.push_back(b);
+        }
+        double plain = 0.0;
+        for (size_t g = 0; g < segmentCount; ++g) plain += weight[g] * s2[g];
+        const auto spent = [&](const std::vector<double>& shape) {  // budget to reach plain's variance
+            double variance = 0.0, total = 0.0;
+            for (size_t g = 0; g < segmentCount; ++g) variance += weight[g] * s[g] * s[g] / shape[g], total += shape[g];
+            return total * variance / plain;
+        };
+        const double plainBudget = double(n * segmentCount);
+        for (int a = 0; a < 20; ++a) {
+            std::vector<double> shape(segmentCount);
+            for (double& v : shape) v = 0.01 + u(rng);
+            EXPECT_GE(spent(shape), plainBudget / sums.ceiling(n) * (1.0 - 1e-12)) << trial;
+        }
+        const std::vector<double> same(segmentCount, 1.0);
+        EXPECT_NEAR(spent(same), plainBudget / sums.uniformCeiling(n), 1e-9 * spent(same)) << trial;
+        std::vector<double> best(segmentCount);
+        for (size_t g = 0; g < segmentCount; ++g) best[g] = std::sqrt(weight[g]) * s[g];
+        EXPECT_NEAR(spent(best), plainBudget / sums.ceiling(n), 1e-9 * spent(best)) << trial;
+        EXPECT_GE(sums.ceiling(n), sums.uniformCeiling(n) * (1.0 - 1e-12)) << trial;
+    }
 }
