@@ -79,6 +79,13 @@ int coordinatorMain(int argc, char** argv) {
         return 2;
     }
     spdlog::set_level(spdlog::level::from_str(logLevel));
+    // A second signal does not cut the drain short (the children of `vrl render --workers` run in a
+    // process group of their own and are stopped by their client's SIGTERM, or by PR_SET_PDEATHSIG,
+    // and a client killed by its second Ctrl-C while stopping us sends both). Made before `cleanup`
+    // so that it outlives it: once the handlers are restored a late SIGTERM kills this process
+    // outright, which left the --remove-on-exit folder behind when it came during the teardown.
+    // Made before exitWithParent's PR_SET_PDEATHSIG too, so that signal is never fatal.
+    util::TerminationSignals signals(false);
     // Removes the --remove-on-exit folder however this function returns.
     const std::unique_ptr<const std::string, void (*)(const std::string*)> cleanup(
         removeOnExit.empty() ? nullptr : &removeOnExit, [](const std::string* path) {
@@ -94,9 +101,6 @@ int coordinatorMain(int argc, char** argv) {
 
     std::optional<tbb::global_control> threadLimit;
     if (threads > 0) threadLimit.emplace(tbb::global_control::max_allowed_parallelism, size_t(threads));
-    // A second signal does not cut the drain short (the children of `vrl render --workers` run in a
-    // process group of their own and are stopped by their client's SIGTERM, or by PR_SET_PDEATHSIG).
-    util::TerminationSignals signals(false);
     try {
         server.token = rpc::loadToken(tokenFile);
         Coordinator coordinator(options);

@@ -48,8 +48,10 @@ int workerMain(int argc, char** argv) {
         return 2;
     }
     spdlog::set_level(spdlog::level::from_str(logLevel));
-    if (!util::exitWithParent()) return 1;
-    util::TerminationSignals signals(false);  // started by `vrl render --workers`, whose process is gone
+    // Before exitWithParent's PR_SET_PDEATHSIG, so that its SIGTERM is always caught. A second signal
+    // does not cut the tiles in flight short.
+    util::TerminationSignals signals(false);
+    if (!util::exitWithParent()) return 1;  // started by `vrl render --workers`, whose process is gone
     try {
         options.token = rpc::loadToken(tokenFile);
         Worker worker(options);
