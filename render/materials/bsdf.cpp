@@ -206,10 +206,14 @@ BsdfLookups Bsdf::lookups(const Vec2& uv, const Vec3& woLocal) const {
     case Kind::RoughPlastic:
         l.diffuse = plasticDiffuse(uv);
         l.fresnelWo = fresnelDielectric(woLocal.z, eta_).reflectance;
-        if (kind_ == Kind::RoughPlastic) l.specular = specularReflectance_.eval(uv);
+        if (kind_ == Kind::RoughPlastic) {
+            l.specular = specularReflectance_.eval(uv);
+            l.lambdaWo = MicrofacetDistribution(distribution_, alphaU_, alphaV_).lambda(woLocal);
+        }
         break;
     case Kind::RoughConductor:
         l.specular = specularReflectance_.eval(uv);
+        l.lambdaWo = MicrofacetDistribution(distribution_, alphaU_, alphaV_).lambda(woLocal);
         break;
     case Kind::Ward:
         l.diffuse = reflectance_.eval(uv);
@@ -218,6 +222,7 @@ BsdfLookups Bsdf::lookups(const Vec2& uv, const Vec3& woLocal) const {
     case Kind::RoughDielectric:
         l.specular = specularReflectance_.eval(uv);
         l.transmission = specularTransmittance_.eval(uv);
+        l.lambdaWo = MicrofacetDistribution(distribution_, alphaU_, alphaV_).lambda(woLocal);
         break;
     }
     return l;
@@ -242,13 +247,13 @@ Rgb Bsdf::evalLocal(const Vec3& wo, const Vec3& wi, const BsdfLookups& l, Transp
         if (kind_ == Kind::RoughPlastic) {
             const Vec3 h = (wo + wi).normalized();
             const float f = fresnelDielectric(wo.dot(h), eta_).reflectance;
-            result += l.specular * (f * dist.D(h) * dist.G(wo, wi, h) / (4.0f * wo.z));
+            result += l.specular * (f * dist.D(h) * dist.G(wo, wi, h, l.lambdaWo) / (4.0f * wo.z));
         }
         return result;
     }
     case Kind::RoughConductor: {
         const Vec3 h = (wo + wi).normalized();
-        const float dg = dist.D(h) * dist.G(wo, wi, h);
+        const float dg = dist.D(h) * dist.G(wo, wi, h, l.lambdaWo);
         if (dg <= 0.0f) return Rgb(0.0f);
         return l.specular * fresnelConductor(wo.dot(h), conductorEta_, conductorK_) * (dg / (4.0f * wo.z));
     }
@@ -262,7 +267,7 @@ Rgb Bsdf::evalLocal(const Vec3& wo, const Vec3& wi, const BsdfLookups& l, Transp
         if (h.length2() < 1e-12f) return Rgb(0.0f);
         h = h.normalized();
         if (h.z < 0.0f) h = -h;
-        const float dg = dist.D(h) * dist.G(wo, wi, h);
+        const float dg = dist.D(h) * dist.G(wo, wi, h, l.lambdaWo);
         if (dg <= 0.0f) return Rgb(0.0f);
         const float cosOH = wo.dot(h), cosIH = wi.dot(h);
         const float f = fresnelDielectric(cosOH, eta_).reflectance;

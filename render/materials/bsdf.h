@@ -61,6 +61,7 @@ struct BsdfLookups {
     Rgb specular{0.0f};  // specular reflectance (rough plastic, rough conductor, ward, rough dielectric)
     Rgb transmission{0.0f};  // specular transmittance (rough dielectric)
     float fresnelWo = 0.0f;  // plastics: F(wo.z)
+    float lambdaWo = 0.0f;   // microfacet models: Smith's Lambda(wo), shared by every wi
 };
 
 // A BSDF at one point for one wo, with everything that depends on them alone

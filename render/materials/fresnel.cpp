@@ -5,22 +5,6 @@
 
 namespace vrl {
 
-DielectricFresnel fresnelDielectric(float cosThetaI, float eta) {
-    if (eta == 1.0f) return {0.0f, -cosThetaI};
-    // Snell: sin_t = sin_i / eta entering, sin_i * eta leaving.
-    const float scale = cosThetaI > 0.0f ? 1.0f / eta : eta;
-    const float cosI = std::min(std::abs(cosThetaI), 1.0f);
-    const float cosTSqr = 1.0f - (1.0f - cosI * cosI) * (scale * scale);
-    if (cosTSqr <= 0.0f) return {1.0f, 0.0f};  // total internal reflection
-    const float cosT = std::sqrt(cosTSqr);
-    // Relative index seen from the incident side.
-    const float n = cosThetaI > 0.0f ? eta : 1.0f / eta;
-    const float rs = (cosI - n * cosT) / (cosI + n * cosT);
-    const float rp = (n * cosI - cosT) / (n * cosI + cosT);
-    const float f = std::clamp(0.5f * (rs * rs + rp * rp), 0.0f, 1.0f);
-    return {f, cosThetaI > 0.0f ? -cosT : cosT};
-}
-
 namespace {
 
 float conductorChannel(float cosI, float eta, float k) {

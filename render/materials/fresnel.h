@@ -8,6 +8,9 @@
 
 #include "render/core/rgb.h"
 
+#include <algorithm>
+#include <cmath>
+
 namespace vrl {
 
 struct DielectricFresnel {
@@ -18,7 +21,23 @@ struct DielectricFresnel {
 };
 
 // cosThetaI > 0: the incident direction is on the exterior (normal) side.
-DielectricFresnel fresnelDielectric(float cosThetaI, float eta);
+// Inline: microfacet BSDFs call it once or twice per evaluation, and a cut's
+// glossy bounds evaluate them at ten points per node.
+inline DielectricFresnel fresnelDielectric(float cosThetaI, float eta) {
+    if (eta == 1.0f) return {0.0f, -cosThetaI};
+    // Snell: sin_t = sin_i / eta entering, sin_i * eta leaving.
+    const float scale = cosThetaI > 0.0f ? 1.0f / eta : eta;
+    const float cosI = std::min(std::abs(cosThetaI), 1.0f);
+    const float cosTSqr = 1.0f - (1.0f - cosI * cosI) * (scale * scale);
+    if (cosTSqr <= 0.0f) return {1.0f, 0.0f};  // total internal reflection
+    const float cosT = std::sqrt(cosTSqr);
+    // Relative index seen from the incident side.
+    const float n = cosThetaI > 0.0f ? eta : 1.0f / eta;
+    const float rs = (cosI - n * cosT) / (cosI + n * cosT);
+    const float rp = (n * cosI - cosT) / (n * cosI + cosT);
+    const float f = std::clamp(0.5f * (rs * rs + rp * rp), 0.0f, 1.0f);
+    return {f, cosThetaI > 0.0f ? -cosT : cosT};
+}
 
 // Conductor reflectance for |cosThetaI| with the complex relative index eta + ik
 // (exact formula, e.g. Mitsuba's fresnelConductorExact). At normal incidence it

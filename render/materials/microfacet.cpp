@@ -217,6 +217,11 @@ float MicrofacetDistribution::G(const Vec3& wo, const Vec3& wi, const Vec3& m) c
     return 1.0f / (1.0f + lambda(wo) + lambda(wi));
 }
 
+float MicrofacetDistribution::G(const Vec3& wo, const Vec3& wi, const Vec3& m, float lambdaWo) const {
+    if (wo.dot(m) * wo.z <= 0.0f || wi.dot(m) * wi.z <= 0.0f) return 0.0f;
+    return 1.0f / (1.0f + lambdaWo + lambda(wi));
+}
+
 Vec3 MicrofacetDistribution::sample(const Vec3& wo, const Vec2& u) const {
     return kind_ == MicrofacetKind::Phong ? samplePhong(u) : sampleVisible(wo, u);
 }

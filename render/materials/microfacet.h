@@ -38,6 +38,8 @@ public:
     float G1(const Vec3& v, const Vec3& m) const;
     // Height-correlated masking-shadowing of wo and wi seen through m.
     float G(const Vec3& wo, const Vec3& wi, const Vec3& m) const;
+    // The same with lambda(wo) given (prepared once for many wi): bit for bit G(wo, wi, m).
+    float G(const Vec3& wo, const Vec3& wi, const Vec3& m, float lambdaWo) const;
 
     // A microfacet normal (m.z > 0) for a view direction with wo.z > 0.
     Vec3 sample(const Vec3& wo, const Vec2& u) const;

@@ -13,6 +13,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <memory>
 #include <optional>
@@ -515,6 +516,34 @@ TEST(FresnelTest, DiffuseReflectanceMatchesQuadrature) {
         const DielectricFresnel out = fresnelDielectric(in.cosThetaT, 1.5f);
         EXPECT_NEAR(in.reflectance, out.reflectance, 1e-5f);
         EXPECT_NEAR(out.cosThetaT, cosI, 1e-5f);
+    }
+}
+
+TEST(MicrofacetTest, GWithAPreparedLambdaOfWoIsBitForBitG) {
+    // PreparedBsdf computes Lambda(wo) once per point (BsdfLookups::lambdaWo) and
+    // passes it to G for every wi: that must be G itself, bit for bit, for every
+    // kind, anisotropy and side (wo, wi below the surface, grazing, opposite m).
+    struct Config {
+        MicrofacetKind kind;
+        float au, av;
+    };
+    const Config configs[] = {{MicrofacetKind::Beckmann, 0.3f, 0.3f}, {MicrofacetKind::Beckmann, 0.05f, 0.9f},
+                              {MicrofacetKind::GGX, 0.3f, 0.3f},      {MicrofacetKind::GGX, 0.6f, 0.02f},
+                              {MicrofacetKind::Phong, 0.3f, 0.3f},    {MicrofacetKind::Phong, 0.01f, 0.5f}};
+    for (size_t ci = 0; ci < std::size(configs); ++ci) {
+        const MicrofacetDistribution dist(configs[ci].kind, configs[ci].au, configs[ci].av);
+        Rng rng(31, ci);
+        int nonZero = 0;
+        for (int i = 0; i < 20'000; ++i) {
+            const Vec3 wo = i % 97 == 0 ? Vec3(1, 0, 0) : uniformSphere(next2(rng));
+            const Vec3 wi = uniformSphere(next2(rng));
+            const Vec3 m = (wo + wi).length() > 1e-3f ? (wo + wi).normalized() : Vec3(0, 0, 1);
+            const float expected = dist.G(wo, wi, m), got = dist.G(wo, wi, m, dist.lambda(wo));
+            ASSERT_EQ(std::bit_cast<uint32_t>(got), std::bit_cast<uint32_t>(expected))
+                << "config " << ci << ", sample " << i << ": " << got << " vs " << expected;
+            nonZero += expected > 0.0f;
+        }
+        EXPECT_GT(nonZero, 3'000) << "config " << ci << ": too few samples where G is not 0 to test anything";
     }
 }
 
