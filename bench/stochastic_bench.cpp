@@ -151,11 +151,7 @@ Ceiling stochasticCeiling(const Scene& scene, const VrlSet& vrls, const LightTre
         std::vector<double> sum(n), squares(n);
         std::vector<bench::EstimateMoments> moments(n), leaves;
         std::vector<double> descent, own;
-        struct Entry {
-            int32_t node;
-            double probability, importance;  // the descent's, and the node's own (from its parent)
-        };
-        std::vector<Entry> stack;
+        std::vector<LeafDescent> stack;
         Sums rowSums;
         for (int x = 0; x < camera.width(); x += stride) {
             const uint64_t pixelIndex = uint64_t(y) * camera.width() + x;
@@ -191,19 +187,12 @@ Ceiling stochasticCeiling(const Scene& scene, const VrlSet& vrls, const LightTre
                 const double k = double(cut.size());
                 for (const int32_t c : cut) {
                     leaves.clear(), descent.clear(), own.clear();
-                    stack.assign(1, {c, 1.0, 1.0});
-                    while (!stack.empty()) {
-                        const auto [node, q, value] = stack.back();
-                        stack.pop_back();
-                        if (isLeafNode(tree, node)) {
-                            leaves.push_back(moments[size_t(node)]), descent.push_back(q), own.push_back(value);
-                            continue;
-                        }
-                        const ChildImportances children = childrenOf(node);
-                        const double pl = leftProbability(children, tree);
-                        stack.push_back({children.node[0], q * pl, children.value[0]});
-                        stack.push_back({children.node[1], q * (1.0 - pl), children.value[1]});
-                    }
+                    forEachLeafDescent(
+                        tree, c, childrenOf,
+                        [&](int32_t leaf, double q, double value) {
+                            leaves.push_back(moments[size_t(leaf)]), descent.push_back(q), own.push_back(value);
+                        },
+                        stack);
                     rowSums.cut += weight * k * bench::nodeVariance(leaves, descent);
                     rowSums.ideal += weight * k * bench::idealNodeVariance(leaves);
                     double ownSum = 0.0;

@@ -231,6 +231,73 @@ TEST(StochasticCut, ZeroImportanceChildrenTakeNoSlot) {
     }
 }
 
+// forEachLeafDescent (which stochasticLeafProbabilities and stochastic_bench's
+// --ceiling predictions are built on) gives the sampler's own probabilities: per
+// draw of stochasticCutEstimate, with every leaf estimate 1, the total is the sum of
+// 1 / P over the drawn leaves, and it must equal the sum of the predicted
+// 1 / P(k | C) (relative 1e-6: the sampler adds them in float); and over
+// 40,000 draws (Rng(14, t)) each leaf's frequency is within 5 binomial standard
+// errors (+1e-9) of its predicted P(k | C). Each cut node's predictions sum to 1.
+// Importances: flux x length times (1 + node % 3), so the branches are uneven.
+TEST(StochasticCut, PredictedDescentProbabilitiesAreTheSamplersOwn) {
+    Rng rng(14, 0);
+    const LightTree tree = LightTree::build(randomVrls(rng, 60), LightTreeSettings{16, 14});
+    const auto weight = [&](int32_t n) {
+        const Rgb& fl = tree.nodes()[n].fluxLength;
+        return (double(fl.x) + fl.y + fl.z) * (1.0 + n % 3);
+    };
+    const auto importance = [&](int32_t n) {
+        const LightTreeNode& node = tree.nodes()[n];
+        return ChildImportances{{node.left, node.right}, {weight(node.left), weight(node.right)}};
+    };
+    constexpr uint32_t kCutSize = 4;
+    const std::vector<int32_t> cut = stochasticCut(tree, kCutSize, importance);
+    ASSERT_EQ(cut.size(), kCutSize);
+    std::vector<double> predicted(tree.vrls().size(), 0.0), ownImportance(tree.vrls().size(), -1.0);
+    std::vector<LeafDescent> stack;
+    for (const int32_t c : cut) {
+        double sum = 0.0;
+        forEachLeafDescent(
+            tree, c, importance,
+            [&](int32_t leaf, double q, double value) {
+                predicted[size_t(leaf)] = q, ownImportance[size_t(leaf)] = value, sum += q;
+            },
+            stack);
+        EXPECT_NEAR(sum, 1.0, 1e-12) << "cut node " << c;
+    }
+    // A leaf's own importance is its parent's pair's value for it (1 for a leaf in the cut).
+    for (int32_t n = 0; n < int32_t(tree.nodes().size()); ++n) {
+        if (isLeafNode(tree, n)) continue;
+        for (const int32_t child : {tree.nodes()[n].left, tree.nodes()[n].right})
+            if (isLeafNode(tree, child) && std::find(cut.begin(), cut.end(), child) == cut.end() &&
+                ownImportance[size_t(child)] >= 0.0)
+                EXPECT_EQ(ownImportance[size_t(child)], weight(child)) << "leaf " << child;
+    }
+    constexpr int kDraws = 40'000;
+    std::vector<int> drawn(tree.vrls().size(), 0);
+    for (int t = 0; t < kDraws; ++t) {
+        Rng draw(14, uint64_t(t) + 1);
+        CutStatistics statistics;
+        double expected = 0.0;
+        const Rgb total = stochasticCutEstimate(tree, kCutSize, draw, statistics, importance,
+                                                [&](const int32_t* leaves, size_t count, Rng&, Rgb* out) {
+                                                    for (size_t k = 0; k < count; ++k) {
+                                                        ++drawn[size_t(leaves[k])];
+                                                        expected += 1.0 / predicted[size_t(leaves[k])];
+                                                        out[k] = Rgb(1.0f);
+                                                    }
+                                                });
+        ASSERT_NEAR(double(total.x), expected, 1e-6 * expected) << "draw " << t;
+    }
+    int reachable = 0;
+    for (size_t k = 0; k < predicted.size(); ++k) {
+        const double p = predicted[k], f = double(drawn[k]) / kDraws;
+        reachable += p > 0.0;
+        EXPECT_NEAR(f, p, 5.0 * std::sqrt(p * (1.0 - p) / kDraws) + 1e-9) << "leaf " << k;
+    }
+    EXPECT_GT(reachable, 40) << "too few leaves with a positive probability to test anything";
+}
+
 // The cut's skip rule (neverTaken) and the descent's probabilities (leftProbability)
 // agree: over pairs of importances from {0, -0, a denormal, 1, 1e300, inf, NaN}, a
 // child the cut skips has probability exactly 0 and its sibling 1; and a child of
