@@ -268,10 +268,12 @@ TEST(StochasticCut, PredictedDescentProbabilitiesAreTheSamplersOwn) {
     // A leaf's own importance is its parent's pair's value for it (1 for a leaf in the cut).
     for (int32_t n = 0; n < int32_t(tree.nodes().size()); ++n) {
         if (isLeafNode(tree, n)) continue;
-        for (const int32_t child : {tree.nodes()[n].left, tree.nodes()[n].right})
+        for (const int32_t child : {tree.nodes()[n].left, tree.nodes()[n].right}) {
             if (isLeafNode(tree, child) && std::find(cut.begin(), cut.end(), child) == cut.end() &&
-                ownImportance[size_t(child)] >= 0.0)
+                ownImportance[size_t(child)] >= 0.0) {
                 EXPECT_EQ(ownImportance[size_t(child)], weight(child)) << "leaf " << child;
+            }
+        }
     }
     constexpr int kDraws = 40'000;
     std::vector<int> drawn(tree.vrls().size(), 0);
