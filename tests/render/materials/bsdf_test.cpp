@@ -519,15 +519,17 @@ TEST(FresnelTest, DiffuseReflectanceMatchesQuadrature) {
     }
 }
 
+// A microfacet distribution and its roughnesses, for the MicrofacetTest cases.
+struct MicrofacetCase {
+    MicrofacetKind kind;
+    float au, av;
+};
+
 TEST(MicrofacetTest, GWithAPreparedLambdaOfWoIsBitForBitG) {
     // PreparedBsdf computes Lambda(wo) once per point (BsdfLookups::lambdaWo) and
     // passes it to G for every wi: that must be G itself, bit for bit, for every
     // kind, anisotropy and side (wo, wi below the surface, grazing, opposite m).
-    struct Config {
-        MicrofacetKind kind;
-        float au, av;
-    };
-    const Config configs[] = {{MicrofacetKind::Beckmann, 0.3f, 0.3f}, {MicrofacetKind::Beckmann, 0.05f, 0.9f},
+    const MicrofacetCase configs[] = {{MicrofacetKind::Beckmann, 0.3f, 0.3f}, {MicrofacetKind::Beckmann, 0.05f, 0.9f},
                               {MicrofacetKind::GGX, 0.3f, 0.3f},      {MicrofacetKind::GGX, 0.6f, 0.02f},
                               {MicrofacetKind::Phong, 0.3f, 0.3f},    {MicrofacetKind::Phong, 0.01f, 0.5f}};
     for (size_t ci = 0; ci < std::size(configs); ++ci) {
@@ -553,11 +555,7 @@ TEST(MicrofacetTest, DistributionsAndVisibleNormalsAreNormalised) {
     // and so do the visible normals G1(wo, m) max(0, wo.m) D(m) / wo.z (which
     // holds only with the distribution's exact Smith Lambda), for several wo.
     // Tolerance: 5 standard errors + 2e-3.
-    struct Config {
-        MicrofacetKind kind;
-        float au, av;
-    };
-    const Config configs[] = {{MicrofacetKind::Beckmann, 0.3f, 0.3f}, {MicrofacetKind::Beckmann, 0.2f, 0.6f},
+    const MicrofacetCase configs[] = {{MicrofacetKind::Beckmann, 0.3f, 0.3f}, {MicrofacetKind::Beckmann, 0.2f, 0.6f},
                               {MicrofacetKind::GGX, 0.3f, 0.3f},      {MicrofacetKind::GGX, 0.6f, 0.2f},
                               {MicrofacetKind::Phong, 0.3f, 0.3f},    {MicrofacetKind::Phong, 0.25f, 0.5f}};
     const Vec3 wos[] = {Vec3(0, 0, 1), direction(Vec3(0, 0, 1), 0.5f, 0.8f), direction(Vec3(0, 0, 1), 0.05f, 2.0f)};
