@@ -282,6 +282,11 @@ int runRender(const RenderCommandOptions& o, const CLI::App& command) {
             else
                 std::fprintf(stderr, "  Henyey-Greenstein media: the heuristic bound, isotropic x (1 + %g)\n",
                              double(settings.cut.bound.anisotropyEpsilon));
+            if (settings.transports.has(TransportPart::MediumSurface))
+                std::fprintf(stderr, "  (c) at glossy surfaces: %s\n",
+                             settings.cut.bound.glossyBound == GlossyBound::Cones
+                                 ? "the proven bound (cones of directions) for rough plastic and conductor (Beckmann, GGX)"
+                                 : "the heuristic bound (corners x 2)");
         }
     }
     return 0;

@@ -110,6 +110,10 @@ void addRenderOptions(CLI::App& cmd, RenderCommandOptions& o) {
                    "(1 + this), instead of the proven bound over cones of directions (the default); vpl-lightcuts: "
                    "always this heuristic (default 1)")
         ->check(CLI::Range(0.0f, 1e6f));
+    cmd.add_flag("--glossy-heuristic", o.glossyHeuristic,
+                 "vrl-lightcuts: bound part (c) at glossy surfaces by the heuristic (twice the largest f|cos| towards "
+                 "ten points of a node's box; faster, may be exceeded) instead of the proven bound over the cone of "
+                 "directions (the default for rough plastic and rough conductor with Beckmann or GGX)");
     cmd.add_option("--partition-size", o.partitionSize,
                     "vrl-lightcuts, vpl-lightcuts: lights per partition before agglomerative clustering (default 2048)")
         ->check(CLI::Range(2u, 1u << 30));
@@ -164,6 +168,7 @@ void warnIneffectiveFlags(const CLI::App& command, RenderMethod method, bool dis
         {"--partition-size", tree, "vrl-lightcuts, vrl-stochastic and vpl-lightcuts"},
         {"--cut-size", method == RenderMethod::VrlStochastic, "vrl-stochastic"},
         {"--exact-distance-below", method == RenderMethod::VrlLightcuts, "vrl-lightcuts"},
+        {"--glossy-heuristic", method == RenderMethod::VrlLightcuts, "vrl-lightcuts"},
         {"--distance-samples", usesVpls(method), "vpl and vpl-lightcuts"},
         {"--shading-points", virtualLights && method != RenderMethod::VrlStochastic,
          "vrl, vrl-lightcuts, vpl and vpl-lightcuts (vrl-stochastic shades every sample)"},
@@ -254,6 +259,7 @@ v1::RenderParameters toRenderParameters(const RenderCommandOptions& o) {
     p.set_exact_distance_below(o.exactDistanceBelow);
     p.set_hg_epsilon(o.hgEpsilon.value_or(ClusterBoundSettings{}.anisotropyEpsilon));
     p.set_hg_epsilon_bound(o.hgEpsilon.has_value());
+    p.set_glossy_heuristic_bound(o.glossyHeuristic);
     p.set_partition_size(o.partitionSize);
     p.set_cut_size(o.cutSize);
     p.set_vrl_sets(o.vrlSets);

@@ -39,6 +39,7 @@ struct RenderCommandOptions {
     float error = 0.02f;
     uint32_t maxCut = 4096;
     uint32_t exactDistanceBelow = 32;
+    bool glossyHeuristic = false;  // vrl-lightcuts: part (c)'s glossy receivers by the heuristic bound
     std::optional<float> hgEpsilon;  // given: vrl-lightcuts use the (1 + epsilon) heuristic in HG media; default 1
     uint32_t partitionSize = 2048;
     uint32_t cutSize = 32;  // vrl-stochastic

@@ -64,8 +64,11 @@ void writeRenderMetadata(const RenderRecord& record, const PerspectiveCamera& ca
             metadata["vrl.maxCut"] = int32_t(s.cut.maxCutSize);
             metadata["vrl.exactDistanceBelow"] = int32_t(s.cut.bound.exactDistanceBelow);
             metadata["vrl.hgEpsilon"] = s.cut.bound.anisotropyEpsilon;
-            if (s.method == RenderMethod::VrlLightcuts)
+            if (s.method == RenderMethod::VrlLightcuts) {
                 metadata["vrl.hgBound"] = std::string(s.cut.bound.hgBound == HgBound::Cones ? "cones" : "epsilon");
+                metadata["vrl.glossyBound"] =
+                    std::string(s.cut.bound.glossyBound == GlossyBound::Cones ? "cones" : "corners");
+            }
         }
         metadata["vrl.partitionSize"] = int32_t(s.partitionSize);
         metadata["vrl.meanEval"] = stats.meanEvaluated;

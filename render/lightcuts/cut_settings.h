@@ -13,6 +13,13 @@ enum class HgBound : uint8_t {
     Epsilon,  // heuristic: the isotropic bound x (1 + anisotropyEpsilon) (the paper's)
 };
 
+// How part (c)'s cut bounds a glossy receiver's f_s |cos| towards a node (surface_cluster_bound.h).
+enum class GlossyBound : uint8_t {
+    Cones,    // proven where the model has PreparedBsdf::coneBound (rough plastic and rough conductor,
+              // Beckmann and GGX); the corners heuristic for the other glossy models
+    Corners,  // heuristic: glossyMargin x the largest f|cos| towards the box's corners, centre and mirror point
+};
+
 struct ClusterBoundSettings {
     uint32_t exactDistanceBelow = 32;  // VRL nodes with at most this many VRLs: h_min from their segments
     // Larger VRL nodes: h_min from the box's bounding sphere (one distance) when that is
@@ -20,7 +27,8 @@ struct ClusterBoundSettings {
     float sphereDistanceBeyond = 0.0f;
     HgBound hgBound = HgBound::Cones;  // VRL cuts; VPL cuts always use the epsilon heuristic
     float anisotropyEpsilon = 1.0f;    // HgBound::Epsilon and VPL cuts: bound x (1 + epsilon)
-    float glossyMargin = 2.0f;         // VRL-lit glossy surfaces: f|cos| towards the box's corners x this
+    GlossyBound glossyBound = GlossyBound::Cones;  // part (c)'s glossy receivers
+    float glossyMargin = 2.0f;         // GlossyBound::Corners: f|cos| towards the box's corners x this
 };
 
 // VPL Lightcuts and plain VPLs: stratified distance samples per camera segment, each

@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <cstdio>
 
 namespace vrl {
 
@@ -70,7 +71,33 @@ double SurfaceClusterBound::phaseBound(int32_t index, const Vec3& x, double slac
     return high;
 }
 
-bool SurfaceClusterBound::provenFor(const Bsdf& bsdf) { return bsdf.lambertianBound(Vec2(0.0f, 0.0f)).has_value(); }
+bool SurfaceClusterBound::provenFor(const Bsdf& bsdf, const ClusterBoundSettings& settings) {
+    return bsdf.lambertianBound(Vec2(0.0f, 0.0f)).has_value() ||
+           (settings.glossyBound == GlossyBound::Cones && bsdf.hasConeBound());
+}
+
+std::optional<Rgb> SurfaceClusterBound::coneBoundTowardsBox(const CameraPathSurface& x, const Imath::Box3f& box,
+                                                            double d, double slack) {
+    // The cone of directions from x to the box: x lies outside it (d > 0), so those
+    // directions are the spherically convex hull of the directions to its corners, and
+    // a cap of half-angle below pi/2 (a convex set) that holds the corners holds them
+    // all. Axis: towards the box's centre. Widened for the rounding of the sample points
+    // (within `slack` of the box, at distance >= d) and of the directions to them.
+    const Imath::V3d p(x.hit.position);
+    const Imath::V3d axis = ((Imath::V3d(box.min) + Imath::V3d(box.max)) * 0.5 - p).normalized();
+    double cosWidest = 1.0;
+    for (int corner = 0; corner < 8; ++corner) {
+        const Imath::V3d q(corner & 1 ? box.max.x : box.min.x, corner & 2 ? box.max.y : box.min.y,
+                           corner & 4 ? box.max.z : box.min.z);
+        const Imath::V3d to = q - p;
+        const double length = to.length();
+        if (length > 0.0) cosWidest = std::min(cosWidest, axis.dot(to) / length);
+    }
+    const double halfAngle = std::acos(std::clamp(cosWidest, -1.0, 1.0)) + 2.0 * slack / d + 1e-6;
+    if (!(d > 0.0) || !(halfAngle < 0.5 * M_PI) || !std::isfinite(axis.x + axis.y + axis.z))
+        return x.bsdf.coneBound(Vec3(0.0f, 0.0f, 1.0f), 4.0);  // every direction
+    return x.bsdf.coneBound(Vec3(float(axis.x), float(axis.y), float(axis.z)), halfAngle);
+}
 
 double SurfaceClusterBound::minimumDistance(int32_t index, const Vec3& x) const {
     const LightTreeNode& node = tree_.nodes()[index];
@@ -83,7 +110,7 @@ double SurfaceClusterBound::minimumDistance(int32_t index, const Vec3& x) const 
 }
 
 Rgb SurfaceClusterBound::reflectionTowardsBox(const CameraPathSurface& x, const Bsdf& bsdf, const Imath::Box3f& box,
-                                              double d, double slack, float glossyMargin,
+                                              double d, double slack, const ClusterBoundSettings& settings,
                                               const Rgb* inheritedGlossy) {
     const Vec3& p = x.hit.position;
     // Reflection only on wo's geometric side: a box wholly behind gives nothing.
@@ -99,6 +126,10 @@ Rgb SurfaceClusterBound::reflectionTowardsBox(const CameraPathSurface& x, const 
         fCos = *lambert * float(cosine);
     } else if (inheritedGlossy) {
         fCos = *inheritedGlossy;
+    } else if (const std::optional<Rgb> cone = settings.glossyBound == GlossyBound::Cones
+                                                     ? coneBoundTowardsBox(x, box, d, slack)
+                                                     : std::nullopt) {
+        fCos = *cone;
     } else {
         // Glossy: the largest f|cos| towards the box's corners, its centre and its
         // point nearest the mirror direction (where a lobe peaks), with a margin (a heuristic).
@@ -122,7 +153,7 @@ Rgb SurfaceClusterBound::reflectionTowardsBox(const CameraPathSurface& x, const 
             const Rgb f = x.bsdf.eval(to / length, TransportMode::Radiance);
             for (int c = 0; c < 3; ++c) largest[c] = std::max(largest[c], f[c]);
         }
-        fCos = largest * glossyMargin;
+        fCos = largest * settings.glossyMargin;
     }
     return fCos;
 }
@@ -160,7 +191,7 @@ Rgb SurfaceClusterBound::boundAt(int32_t index, const CameraPathSurface& x, doub
 
     const SceneShape& shape = scene_.shapes()[x.hit.shape];
     const bool reflectsOnly = shape.bsdf.kind() != BsdfDescription::Kind::RoughDielectric;
-    const Rgb fCos = reflectionTowardsBox(x, shape.bsdf, node.box, d, slack, settings_.glossyMargin, inheritedGlossy);
+    const Rgb fCos = reflectionTowardsBox(x, shape.bsdf, node.box, d, slack, settings_, inheritedGlossy);
     if (factor) *factor = fCos;
     if (isBlack(fCos)) return Rgb(0.0f);
 

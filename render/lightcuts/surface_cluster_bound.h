@@ -76,7 +76,7 @@ public:
     // The distance from x to the node used by the bound (box, or exact for small nodes).
     double minimumDistance(int32_t node, const Vec3& x) const;
     // Whether the bound is proven for the BSDF at x (diffuse) or a heuristic (glossy).
-    static bool provenFor(const Bsdf& bsdf);
+    static bool provenFor(const Bsdf& bsdf, const ClusterBoundSettings& settings = {});
     // The receiver's factor above, also the surface-VPL cut's at a surface point
     // (surface_vpl_cut.h): a bound on f_s(x; wo, wi) |cos(wi, n_s)| over the
     // directions wi from x to the points of `box`, at distance >= d > 0 from x
@@ -85,9 +85,14 @@ public:
     // above with `glossyMargin`.
     // `inheritedGlossy`: for a glossy x, the factor to use instead of evaluating the BSDF.
     static Rgb reflectionTowardsBox(const CameraPathSurface& x, const Bsdf& bsdf, const Imath::Box3f& box, double d,
-                                    double slack, float glossyMargin, const Rgb* inheritedGlossy = nullptr);
+                                    double slack, const ClusterBoundSettings& settings,
+                                    const Rgb* inheritedGlossy = nullptr);
 
 private:
+    // x's PreparedBsdf::coneBound over the cone of directions from x to `box`; empty
+    // where the model has none there (the glossy heuristic applies).
+    static std::optional<Rgb> coneBoundTowardsBox(const CameraPathSurface& x, const Imath::Box3f& box, double d,
+                                                  double slack);
     // The bound at distance >= d (after the rounding slack; d <= 0: x may lie in the node).
     Rgb boundAt(int32_t node, const CameraPathSurface& x, double d, double slack, const Rgb* inheritedGlossy,
                 Rgb* factor) const;

@@ -164,7 +164,7 @@ std::array<double, 3> SurfaceVplLightcutsEstimator::pointBound(int32_t index, co
     const double dPositive = d > 0.0 ? d : 1e-30;
     const SceneShape& shape = scene_.shapes()[x.hit.shape];
     const Rgb fCos = SurfaceClusterBound::reflectionTowardsBox(x, shape.bsdf, node.box, dPositive, slack,
-                                                               settings_.bound.glossyMargin);
+                                                               settings_.bound);
     if (isBlack(fCos)) return {0.0, 0.0, 0.0};
     double cosine = 1.0;  // at y (surface_vpl_cut.h)
     if (d > 0.0 && !normals_.empty() && normals_[size_t(index)].spread >= 0.0f && normals_[size_t(index)].spread < 1.0f) {

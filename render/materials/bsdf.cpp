@@ -17,7 +17,9 @@
 #include "render/materials/microfacet.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
+#include <limits>
 #include <stdexcept>
 #include <string>
 
@@ -468,6 +470,120 @@ float Bsdf::glossyRoughness() const {
 std::optional<Rgb> PreparedBsdf::lambertianBound() const {
     if (!bsdf_) return Rgb(0.0f);
     return bsdf_->lambertianBoundOf(lookups_.diffuse);
+}
+
+bool Bsdf::hasConeBound() const {
+    if (kind_ == Kind::Diffuse || kind_ == Kind::Plastic) return true;
+    return (kind_ == Kind::RoughPlastic || kind_ == Kind::RoughConductor) &&
+           (distribution_ == MicrofacetKind::GGX || distribution_ == MicrofacetKind::Beckmann);
+}
+
+namespace {
+
+using V3d = Imath::V3d;
+constexpr double kPiD = 3.14159265358979323846;
+
+// A bound: empty where it is not finite (never black in its place).
+std::optional<Rgb> finiteBound(const Rgb& b) { return isFinite(b) ? std::optional<Rgb>(b) : std::nullopt; }
+
+// The largest D over normals whose angle to n lies in [thetaLow, thetaHigh] (within
+// [0, pi/2]), from the isotropic majorant of bsdf.h's derivation.
+double microfacetMaximum(MicrofacetKind kind, double alphaU, double alphaV, double thetaLow, double thetaHigh) {
+    const double au = std::clamp(alphaU, double(MicrofacetDistribution::kMinAlpha), double(MicrofacetDistribution::kMaxAlpha));
+    const double av = std::clamp(alphaV, double(MicrofacetDistribution::kMinAlpha), double(MicrofacetDistribution::kMaxAlpha));
+    const double a2 = std::max(au, av) * std::max(au, av), norm = 1.0 / (kPiD * au * av);
+    if (kind == MicrofacetKind::GGX) {
+        const auto at = [&](double theta) {
+            const double s = std::sin(theta), c = std::cos(theta);
+            const double base = c * c + s * s / a2;
+            return norm / (base * base);
+        };
+        return std::max(at(thetaLow), at(thetaHigh));
+    }
+    // Beckmann: g(t) = e^(-t / a2) (1 + t)^2, t = tan^2 theta, rises up to t* = 2 a2 - 1.
+    const auto g = [&](double t) { return std::isfinite(t) ? std::exp(-t / a2) * (1.0 + t) * (1.0 + t) : 0.0; };
+    const double tLow = std::tan(thetaLow) * std::tan(thetaLow);
+    const double tHigh = thetaHigh >= 0.5 * kPiD ? std::numeric_limits<double>::infinity()
+                                                 : std::tan(thetaHigh) * std::tan(thetaHigh);
+    const double tPeak = 2.0 * a2 - 1.0;
+    const double best = tPeak > tLow && tPeak < tHigh ? g(tPeak) : std::max(g(tLow), g(tHigh));
+    return norm * best;
+}
+
+}  // namespace
+
+std::optional<Rgb> PreparedBsdf::coneBound(const Vec3& axis, double halfAngle) const {
+    if (!bsdf_) return Rgb(0.0f);
+    if (!bsdf_->hasConeBound()) return std::nullopt;
+    using Kind = BsdfDescription::Kind;
+    const V3d c = V3d(setup_.frame.toLocal(axis)).normalized();
+    const double beta = std::max(0.0, halfAngle);
+    const double thetaC = std::acos(std::clamp(c.z, -1.0, 1.0));
+    const double cosMax = thetaC - beta <= 0.0 ? 1.0 : std::cos(std::min(thetaC - beta, kPiD));
+    if (const std::optional<Rgb> lambert = bsdf_->lambertianBoundOf(lookups_.diffuse))
+        return *lambert * float(std::max(0.0, cosMax) * 1.0001);
+    const V3d wo = V3d(setup_.woLocal).normalized();
+    if (!(wo.z > 0.0)) return std::nullopt;
+    // The half vectors' range of angles to n.
+    const double gammaC = std::acos(std::clamp(wo.dot(c), -1.0, 1.0));
+    const double gammaMax = gammaC + beta;
+    double thetaLow = 0.0, thetaHigh = 0.5 * kPiD;
+    if (gammaMax < kPiD) {
+        // beta < pi - gammaC here. The map wi -> h is a diffeomorphism of the sphere less
+        // -wo onto the hemisphere around wo, and the angle of h to n has one critical
+        // point there, its minimum 0 at the mirror direction r of wo. So over the cap,
+        // theta_h takes its extremes on the boundary circle, and its minimum is 0 where
+        // the cap holds r. Along the circle wi(psi) = c cos beta + (u cos psi + v sin psi)
+        // sin beta, |d wi / d psi| = sin beta, so theta_h moves by at most
+        // sin beta / (2 cos(gamma_max / 2)) per radian of psi (above): every point of the
+        // circle lies within pi / kCirclePoints (in psi) of one of kCirclePoints evenly
+        // spread points, which bound the extremes up to that slack. Plus 1e-6: eval's float half vector (a
+        // few float steps of a unit vector) may lie that much further out, where a
+        // narrow lobe's slope is steep.
+        constexpr int kCirclePoints = 12;
+        const double lipschitz = 1.0 / (2.0 * std::cos(0.5 * gammaMax));
+        const double slack = kPiD / kCirclePoints * std::sin(std::min(beta, 0.5 * kPiD)) * lipschitz + 1e-6;
+        const V3d r(-wo.x, -wo.y, wo.z);
+        const bool holdsMirror = r.dot(c) >= std::cos(beta);
+        double zLow = 1.0, zHigh = -1.0;
+        if (beta * lipschitz < 1e-3) {  // a small cone: about its centre's half vector
+            const double thetaH = std::acos(std::clamp((wo + c).normalized().z, -1.0, 1.0));
+            thetaLow = std::max(0.0, thetaH - beta * lipschitz - 1e-6);
+            thetaHigh = std::min(0.5 * kPiD, thetaH + beta * lipschitz + 1e-6);
+        } else {
+            const V3d u = (std::abs(c.x) < 0.9 ? V3d(1, 0, 0) : V3d(0, 1, 0)).cross(c).normalized();
+            const V3d v = c.cross(u);
+            const double cosBeta = std::cos(beta), sinBeta = std::sin(beta);
+            static const std::array<std::pair<double, double>, kCirclePoints> kCircle = [] {
+                std::array<std::pair<double, double>, kCirclePoints> points;
+                for (int k = 0; k < kCirclePoints; ++k) {
+                    const double psi = 2.0 * kPiD * (k + 0.5) / kCirclePoints;
+                    points[size_t(k)] = {std::cos(psi), std::sin(psi)};
+                }
+                return points;
+            }();
+            for (const auto& [cosPsi, sinPsi] : kCircle) {
+                const V3d wi = c * cosBeta + (u * cosPsi + v * sinPsi) * sinBeta;
+                const double z = (wo + wi).normalized().z;
+                zLow = std::min(zLow, z), zHigh = std::max(zHigh, z);
+            }
+            thetaLow = std::max(0.0, std::acos(std::clamp(zHigh, -1.0, 1.0)) - slack);
+            thetaHigh = std::min(0.5 * kPiD, std::acos(std::clamp(zLow, -1.0, 1.0)) + slack);
+        }
+        if (holdsMirror) thetaLow = 0.0;
+    }
+    const Bsdf& b = *bsdf_;
+    const double dMax =
+        thetaLow >= 0.5 * kPiD ? 0.0 : microfacetMaximum(b.distribution_, b.alphaU_, b.alphaV_, thetaLow, thetaHigh);
+    // G <= 1 / (1 + Lambda(wo)): Lambda(wi) >= 0.
+    const double specular = dMax / (4.0 * wo.z * (1.0 + double(lookups_.lambdaWo)));
+    if (b.kind_ == Kind::RoughConductor) return finiteBound(lookups_.specular * float(specular * 1.0001));
+    // Rough plastic.
+    const double fresnelMax =
+        b.eta_ > 1.0f ? double(fresnelDielectric(float(std::cos(0.5 * std::min(gammaMax, kPiD))), b.eta_).reflectance)
+                      : 1.0;
+    const double diffuse = (1.0 - double(lookups_.fresnelWo)) * std::max(0.0, cosMax) / (kPiD * double(b.eta_) * double(b.eta_));
+    return finiteBound((lookups_.specular * float(fresnelMax * specular) + lookups_.diffuse * float(diffuse)) * 1.0001f);
 }
 
 Rgb Bsdf::albedo(const Vec2& uv) const {

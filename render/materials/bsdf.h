@@ -76,6 +76,52 @@ public:
     // read): a bound on eval(wi) / |cos| over every wi. 0 where nothing was
     // prepared (eval is black for every wi); empty for non-Lambertian models.
     std::optional<Rgb> lambertianBound() const;
+    // A proven bound on eval(wi, Radiance) over every unit wi within `halfAngle`
+    // (radians, >= pi: every direction) of the unit world-space `axis`: the largest
+    // f |cos| a receiver can show towards a light cluster seen under that cone.
+    // For diffuse and smooth plastic, and for rough plastic and rough conductor
+    // with a Beckmann or GGX distribution where wo lies above the shading horizon
+    // (Bsdf::hasConeBound); empty elsewhere (Phong, Ward, rough dielectric, wo at or
+    // below the shading horizon). 0 where nothing was prepared.
+    //
+    // Derivation (local shading frame, n = +z; the models of evalLocal). Let c be
+    // the axis and beta the half-angle; every wi in the cone has
+    //   theta_i >= theta_c - beta  (theta: the angle to n),
+    //   gamma = angle(wo, wi) <= gamma_max = angle(wo, c) + beta.
+    // Cosine terms: wi.z <= cos(max(0, theta_c - beta)) = cosMax.
+    // Half vector h = (wo + wi) / |wo + wi|. Along the great-circle arc from c to
+    // wi (inside the cone) with unit speed, d(wo + wi) has length 1 and
+    // normalising divides its tangential part by |wo + wi| = 2 cos(gamma / 2), so
+    //   angle(h, h_c) <= beta / (2 cos(gamma_max / 2)) = beta_h   (gamma_max < pi),
+    // and theta_h lies in [theta_hc - beta_h, theta_hc + beta_h] clamped to [0, pi/2]
+    // (D = 0 below the horizon): the range taken for small cones (beta_h < 1e-3).
+    // Wider cones: wi -> h is a diffeomorphism of the sphere less -wo onto the
+    // hemisphere around wo, and theta_h has one critical point there, its minimum 0
+    // at wo's mirror direction r; so over the cap theta_h takes its extremes on the
+    // boundary circle (its minimum is 0 where the cap holds r). Twelve points spread
+    // evenly on the circle give them up to pi/12 x sin(beta) x beta_h / beta (the
+    // circle's length per radian, times the Lipschitz factor above). Both ranges are
+    // widened by 1e-6 for eval's float half vector, where a narrow lobe is steep.
+    // With gamma_max >= pi every h is possible.
+    // D: with x^2 + y^2 = sin^2 theta_h and alpha_max = max(alpha_u, alpha_v),
+    //   x^2/au^2 + y^2/av^2 >= sin^2 theta_h / alpha_max^2, so
+    //   GGX       D <= 1 / (pi au av (cos^2 + sin^2 / alpha_max^2)^2): the base is linear
+    //             in sin^2, so the largest value is at an end of the theta_h range;
+    //   Beckmann  D <= e^(-t / alpha_max^2) (1 + t)^2 / (pi au av), t = tan^2 theta_h,
+    //             largest at t* = 2 alpha_max^2 - 1 where t* is in range, else at an end.
+    // G <= 1 / (1 + Lambda(wo)) (Smith's height-correlated G = 1 / (1 + Lambda_o + Lambda_i)
+    // or 0, Lambda >= 0).
+    // Fresnel: the plastic's F(wo.h) with wo.h = cos(gamma / 2) >= cos(gamma_max / 2);
+    // for eta > 1 the unpolarised reflectance grows with the angle (bsdf_test checks
+    // it on a fine grid), so F <= F(cos(min(gamma_max, pi) / 2)); for eta <= 1, F <= 1.
+    // The conductor's F <= 1.
+    // So, with k_s the specular reflectance and wo.z > 0 fixed,
+    //   rough conductor  f |cos| = k_s F D G / (4 wo.z) <= k_s D_max G_max / (4 wo.z);
+    //   rough plastic    f |cos| <= k_s F_max D_max G_max / (4 wo.z)
+    //                              + rho (1 - F(wo)) cosMax / (pi eta^2)   (1 - F(wi) <= 1).
+    // Float evaluation of those terms is covered by a 1.0001 factor (relative
+    // errors of a few float steps); rounding of the caller's directions belongs in beta.
+    std::optional<Rgb> coneBound(const Vec3& axis, double halfAngle) const;
 
 private:
     friend class Bsdf;
@@ -112,6 +158,10 @@ public:
     // (its diffuse base through the coating, (1 - F) <= 1). Empty for the others
     // (glossy lobes, purely specular and null models).
     std::optional<Rgb> lambertianBound(const Vec2& uv) const;
+    // Whether PreparedBsdf::coneBound is proven for this model (wherever wo lies above
+    // the shading horizon): Lambertian-bounded models, and rough plastic and rough
+    // conductor with a Beckmann or GGX distribution.
+    bool hasConeBound() const;
     // The glossy lobe's roughness: the smaller of alpha_u and alpha_v for the rough
     // (microfacet) models and Ward; 0 for models without a glossy lobe.
     float glossyRoughness() const;

@@ -76,6 +76,7 @@ v1::RenderParameters defaultRenderParameters(RenderMethod method) {
     p.set_exact_distance_below(d.cut.bound.exactDistanceBelow);
     p.set_hg_epsilon(d.cut.bound.anisotropyEpsilon);
     p.set_hg_epsilon_bound(d.cut.bound.hgBound == HgBound::Epsilon);
+    p.set_glossy_heuristic_bound(d.cut.bound.glossyBound == GlossyBound::Corners);
     p.set_partition_size(d.partitionSize);
     p.set_cut_size(d.cut.stochasticCutSize);
     p.set_vrl_sets(uint32_t(d.vrlSets));
@@ -232,6 +233,7 @@ ResolvedJob resolveJob(const std::filesystem::path& sceneFile, const v1::JobSpec
     s.cut.bound.exactDistanceBelow = p.exact_distance_below();
     s.cut.bound.anisotropyEpsilon = p.hg_epsilon();
     s.cut.bound.hgBound = p.hg_epsilon_bound() ? HgBound::Epsilon : HgBound::Cones;
+    s.cut.bound.glossyBound = p.glossy_heuristic_bound() ? GlossyBound::Corners : GlossyBound::Cones;
     s.partitionSize = p.partition_size();
     if (p.cut_size() > 0) s.cut.stochasticCutSize = p.cut_size();
     s.vrlSets = p.vrl_sets() > 0 ? int(p.vrl_sets()) : 1;

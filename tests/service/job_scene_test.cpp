@@ -123,6 +123,18 @@ TEST(ResolveJob, HgBoundIsTheProvenOneUnlessTheHeuristicIsAskedFor) {
     EXPECT_EQ(s.cut.bound.anisotropyEpsilon, 0.5f);
 }
 
+// Part (c)'s bound at glossy surfaces: the proven cone bound unless the spec asks for
+// the heuristic; the defaults the client starts from say "cones".
+TEST(ResolveJob, GlossyBoundIsTheProvenOneUnlessTheHeuristicIsAskedFor) {
+    const test::TempDir dir("vrl-job-scene");
+    const auto scene = writeScene(dir, "");
+    v1::JobSpec spec = specWithMethod("vrl-lightcuts");
+    EXPECT_FALSE(rpc::defaultRenderParameters(RenderMethod::VrlLightcuts).glossy_heuristic_bound());
+    EXPECT_EQ(rpc::resolveJob(scene, spec, {}).settings.cut.bound.glossyBound, GlossyBound::Cones);
+    spec.mutable_parameters()->set_glossy_heuristic_bound(true);
+    EXPECT_EQ(rpc::resolveJob(scene, spec, {}).settings.cut.bound.glossyBound, GlossyBound::Corners);
+}
+
 TEST(ResolveJob, VrlSetsAreForVrlStochasticWithinTheVrlLimit) {
     const test::TempDir dir("vrl-job-scene");
     const auto scene = writeScene(dir, "");
