@@ -33,12 +33,17 @@
 //   - sigma_s: the node's medium's, or the largest of all media.
 // With Phi_C L_rep = the node's flux x length:
 //   bound = fluxLength sigma_s f_p,max (rho/pi) cos_max T_r(d) throughput / d^2.
-// Glossy models (every non-diffuse kind with a non-Dirac lobe) have no such
-// bound here: theirs is glossyMargin times the largest f_s|cos| towards the
-// box's corners, its centre and its point nearest the mirror direction of wo
-// (where a lobe peaks): a heuristic; CutStatistics::boundExceeded counts the
-// estimates above it. (Refining every node wider than its distance instead
-// made staircase's cuts reach 19,000 of 10^5 VRLs per pixel, 6x the time.) Float rounding of sample points: d is taken a few float
+// Glossy models: rough plastic and rough conductor with a Beckmann or GGX lobe
+// (GlossyBound::Cones, the default) take PreparedBsdf::coneBound over the cone of
+// directions from x to the box (a cap around the directions to its corners, which
+// holds them all when x lies outside the box: they are its spherically convex
+// hull; proven, derivation in materials/bsdf.h). The other glossy models (Phong,
+// Ward, rough dielectric), and all with GlossyBound::Corners, take glossyMargin
+// times the largest f_s|cos| towards the box's corners, its centre and its point
+// nearest the mirror direction of wo (where a lobe peaks): a heuristic;
+// CutStatistics::boundExceeded counts the estimates above it. (Refining every
+// node wider than its distance instead made staircase's cuts reach 19,000 of
+// 10^5 VRLs per pixel, 6x the time.) Float rounding of sample points: d is taken a few float
 // steps closer and the bound carries a 1.001 margin, as in cluster_bound.h.
 #pragma once
 
@@ -66,9 +71,9 @@ public:
     Rgb bound(int32_t node, const CameraPathSurface& x, bool* xInsideNode = nullptr, Rgb* factor = nullptr) const;
     // A cheaper bound for the cut's deferred bounds (cut_walk.h); *tight says whether it
     // is the full one. For a glossy x, given `inheritedGlossy` (the factor of a box that
-    // holds this node's box: its parent's), it takes that factor instead of the 10 BSDF
-    // evaluations, a heuristic as theirs is: the directions to the node are among those
-    // to the parent's box. Elsewhere it is the full bound. (Deferring a small node's exact
+    // holds this node's box: its parent's), it takes that factor instead of its own: the
+    // directions to the node are among those to the parent's box, so a proven (cone)
+    // factor stays proven, a heuristic one stays a heuristic. Elsewhere it is the full bound. (Deferring a small node's exact
     // distance as well, with the box's distance as the cheap one, made renders slower:
     // nearly every such node reached the heap's top and paid for both.)
     Rgb cheapBound(int32_t node, const CameraPathSurface& x, bool* xInsideNode, const Rgb* inheritedGlossy,
