@@ -614,11 +614,7 @@ TEST(BsdfTest, ConeBoundHoldsOverItsCone) {
     // the shading normal tilted from the geometric one; half-angles from 1e-4 to pi.
     // And not vacuous: towards the mirror direction the bound is within 4x of the
     // largest value found. Models without a proof give none. Fixed seeds.
-    struct ConeCase {
-        std::string name;
-        BsdfDescription description;
-    };
-    std::vector<ConeCase> models = {
+    std::vector<Case> models = {
         {"roughplastic-ggx-0.1", describe(Kind::RoughPlastic, MicrofacetKind::GGX, 0.1f, 0.1f)},
         {"roughplastic-ggx-0.02", describe(Kind::RoughPlastic, MicrofacetKind::GGX, 0.02f, 0.02f)},
         {"roughplastic-beckmann-aniso", describe(Kind::RoughPlastic, MicrofacetKind::Beckmann, 0.05f, 0.5f)},
