@@ -80,14 +80,17 @@ public:
                    Rgb* factor, bool* tight) const;
     // The distance from x to the node used by the bound (box, or exact for small nodes).
     double minimumDistance(int32_t node, const Vec3& x) const;
-    // Whether the bound is proven for the BSDF at x (diffuse) or a heuristic (glossy).
+    // Whether the bound is proven for the BSDF at x (Lambertian-bounded models; with
+    // GlossyBound::Cones also rough plastic and rough conductor, Beckmann and GGX) or a
+    // heuristic (the other glossy models).
     static bool provenFor(const Bsdf& bsdf, const ClusterBoundSettings& settings = {});
     // The receiver's factor above, also the surface-VPL cut's at a surface point
     // (surface_vpl_cut.h): a bound on f_s(x; wo, wi) |cos(wi, n_s)| over the
     // directions wi from x to the points of `box`, at distance >= d > 0 from x
     // (`slack`: the rounding margin of the caller's distances). 0 where the whole
-    // box lies behind a reflecting x; Lambertian: proven, glossy: the heuristic
-    // above with `glossyMargin`.
+    // box lies behind a reflecting x; Lambertian: proven; glossy: the cone bound above
+    // where settings.glossyBound and the model allow it (proven), else the heuristic
+    // with `glossyMargin`.
     // `inheritedGlossy`: for a glossy x, the factor to use instead of evaluating the BSDF.
     static Rgb reflectionTowardsBox(const CameraPathSurface& x, const Bsdf& bsdf, const Imath::Box3f& box, double d,
                                     double slack, const ClusterBoundSettings& settings,

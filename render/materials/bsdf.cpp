@@ -537,9 +537,9 @@ std::optional<Rgb> PreparedBsdf::coneBound(const Vec3& axis, double halfAngle) c
         // sin beta, |d wi / d psi| = sin beta, so theta_h moves by at most
         // sin beta / (2 cos(gamma_max / 2)) per radian of psi (above): every point of the
         // circle lies within pi / kCirclePoints (in psi) of one of kCirclePoints evenly
-        // spread points, which bound the extremes up to that slack. Plus 1e-6: eval's float half vector (a
-        // few float steps of a unit vector) may lie that much further out, where a
-        // narrow lobe's slope is steep.
+        // spread points, which bound the extremes up to that slack. Plus 1e-6: eval's
+        // float half vector (a few float steps of a unit vector) may lie that much
+        // further out, where a narrow lobe's slope is steep.
         constexpr int kCirclePoints = 12;
         const double lipschitz = 1.0 / (2.0 * std::cos(0.5 * gammaMax));
         const double slack = kPiD / kCirclePoints * std::sin(std::min(beta, 0.5 * kPiD)) * lipschitz + 1e-6;
