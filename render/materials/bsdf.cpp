@@ -20,6 +20,7 @@
 #include <array>
 #include <cmath>
 #include <limits>
+#include <numbers>
 #include <stdexcept>
 #include <string>
 
@@ -481,7 +482,7 @@ bool Bsdf::hasConeBound() const {
 namespace {
 
 using V3d = Imath::V3d;
-constexpr double kPiD = 3.14159265358979323846;
+constexpr double kPiD = std::numbers::pi;
 
 // A bound: empty where it is not finite (never black in its place).
 std::optional<Rgb> finiteBound(const Rgb& b) { return isFinite(b) ? std::optional<Rgb>(b) : std::nullopt; }
@@ -542,10 +543,8 @@ std::optional<Rgb> PreparedBsdf::coneBound(const Vec3& axis, double halfAngle) c
         // further out, where a narrow lobe's slope is steep.
         constexpr int kCirclePoints = 12;
         const double lipschitz = 1.0 / (2.0 * std::cos(0.5 * gammaMax));
-        const double slack = kPiD / kCirclePoints * std::sin(std::min(beta, 0.5 * kPiD)) * lipschitz + 1e-6;
         const V3d r(-wo.x, -wo.y, wo.z);
         const bool holdsMirror = r.dot(c) >= std::cos(beta);
-        double zLow = 1.0, zHigh = -1.0;
         if (beta * lipschitz < 1e-3) {  // a small cone: about its centre's half vector
             const double thetaH = std::acos(std::clamp((wo + c).normalized().z, -1.0, 1.0));
             thetaLow = std::max(0.0, thetaH - beta * lipschitz - 1e-6);
@@ -554,6 +553,8 @@ std::optional<Rgb> PreparedBsdf::coneBound(const Vec3& axis, double halfAngle) c
             const V3d u = (std::abs(c.x) < 0.9 ? V3d(1, 0, 0) : V3d(0, 1, 0)).cross(c).normalized();
             const V3d v = c.cross(u);
             const double cosBeta = std::cos(beta), sinBeta = std::sin(beta);
+            const double slack = kPiD / kCirclePoints * std::sin(std::min(beta, 0.5 * kPiD)) * lipschitz + 1e-6;
+            double zLow = 1.0, zHigh = -1.0;
             static const std::array<std::pair<double, double>, kCirclePoints> kCircle = [] {
                 std::array<std::pair<double, double>, kCirclePoints> points;
                 for (int k = 0; k < kCirclePoints; ++k) {
