@@ -1,4 +1,4 @@
-// Line-to-segments distances in double lanes (contract: segment_distances.h).
+// Line- and point-to-segments distances in double lanes (contract: segment_distances.h).
 
 #undef HWY_TARGET_INCLUDE
 #define HWY_TARGET_INCLUDE "render/core/segment_distances.cpp"
@@ -8,6 +8,7 @@
 
 #include "render/core/segment_distances.h"
 
+#include <cmath>
 #include <limits>
 
 HWY_BEFORE_NAMESPACE();
@@ -52,6 +53,34 @@ double MinDistanceLineSegments(const Vec3& origin, const Vec3& direction, const 
     return hn::GetLane(hn::MinOfLanes(dd, best));
 }
 
+double MinDistancePointSegments(const Vec3& point, const SegmentLanes& s, size_t count) {
+    const hn::ScalableTag<double> dd;
+    const hn::Rebind<float, decltype(dd)> df;
+    using V = hn::Vec<decltype(dd)>;
+    const V px = hn::Set(dd, double(point.x)), py = hn::Set(dd, double(point.y)), pz = hn::Set(dd, double(point.z));
+    const V zero = hn::Zero(dd), one = hn::Set(dd, 1.0);
+    // The smallest squared distance: sqrt is monotone and correctly rounded, so the
+    // square root of the minimum is the minimum of the scalar loop's square roots.
+    V best = hn::Set(dd, std::numeric_limits<double>::infinity());
+    const size_t lanes = hn::Lanes(dd);
+    for (size_t i = 0; i < count; i += lanes) {
+        const auto load = [&](const float* p) { return hn::PromoteTo(dd, hn::LoadU(df, p + i)); };
+        const V ax = load(s.ax), ay = load(s.ay), az = load(s.az);
+        // distancePointSegment: ab = b - a, ap = point - a, s = clamp(ap.ab / ab.ab, 0, 1).
+        const V abx = hn::Sub(load(s.bx), ax), aby = hn::Sub(load(s.by), ay), abz = hn::Sub(load(s.bz), az);
+        const V apx = hn::Sub(px, ax), apy = hn::Sub(py, ay), apz = hn::Sub(pz, az);
+        const V ll = Dot3(abx, aby, abz, abx, aby, abz);
+        const auto degenerate = hn::Not(hn::Gt(ll, zero));
+        const V t = hn::Div(Dot3(apx, apy, apz, abx, aby, abz), hn::IfThenElse(degenerate, one, ll));
+        const V sClamped = hn::IfThenZeroElse(degenerate, hn::Min(hn::Max(t, zero), one));
+        const V cx = hn::Sub(apx, hn::Mul(abx, sClamped)), cy = hn::Sub(apy, hn::Mul(aby, sClamped)),
+                cz = hn::Sub(apz, hn::Mul(abz, sClamped));
+        const auto inRange = hn::FirstN(dd, count - i);
+        best = hn::IfThenElse(inRange, hn::Min(best, Dot3(cx, cy, cz, cx, cy, cz)), best);
+    }
+    return std::sqrt(hn::GetLane(hn::MinOfLanes(dd, best)));
+}
+
 }  // namespace HWY_NAMESPACE
 }  // namespace vrl
 HWY_AFTER_NAMESPACE();
@@ -63,6 +92,12 @@ HWY_EXPORT(MinDistanceLineSegments);
 
 double minDistanceLineSegments(const Vec3& origin, const Vec3& direction, const SegmentLanes& segments, size_t count) {
     return HWY_DYNAMIC_DISPATCH(MinDistanceLineSegments)(origin, direction, segments, count);
+}
+
+HWY_EXPORT(MinDistancePointSegments);
+
+double minDistancePointSegments(const Vec3& point, const SegmentLanes& segments, size_t count) {
+    return HWY_DYNAMIC_DISPATCH(MinDistancePointSegments)(point, segments, count);
 }
 
 }  // namespace vrl

@@ -154,6 +154,14 @@ Rgb walkCut(const LightTree& tree, const CutSettings& settings, CutStatistics& s
         return Rgb(from.x > 0.0f ? e.x * (to.x / from.x) : 0.0f, from.y > 0.0f ? e.y * (to.y / from.y) : 0.0f,
                    from.z > 0.0f ? e.z * (to.z / from.z) : 0.0f);
     };
+    // The walk's time goes mostly to cache misses on the nodes it reaches and on their
+    // representatives' records: a refinement announces its children's nodes, and a
+    // queued node its representative, before they are read (no effect on results).
+    const auto prefetchNode = [&](int32_t i) {
+        const char* first = reinterpret_cast<const char*>(&nodes[size_t(i)]);
+        __builtin_prefetch(first);
+        __builtin_prefetch(first + sizeof(LightTreeNode) - 1);
+    };
     const auto exceeds = [](const Rgb& e, const Rgb& b) { return e.x > b.x || e.y > b.y || e.z > b.z; };
     const auto heapKey = [](const Rgb& b) {
         const float key = luminance(b);
@@ -201,6 +209,7 @@ Rgb walkCut(const LightTree& tree, const CutSettings& settings, CutStatistics& s
                 // representative: its children may inherit from it. Its children get the
                 // factor it was given (their boxes lie in its parent's).
                 const Rgb e = shares ? inherit(p.parentEstimate, p.parent, i) : Rgb(0.0f);
+                prefetchNode(node.left), prefetchNode(node.right);
                 pending.push_back({node.left, shares ? i : -1, e, p.parentFactor});
                 pending.push_back({node.right, shares ? i : -1, e, p.parentFactor});
                 continue;
@@ -211,6 +220,8 @@ Rgb walkCut(const LightTree& tree, const CutSettings& settings, CutStatistics& s
                 if constexpr (kDeferred) scratch.addedStates.push_back(d);
                 continue;
             }
+            __builtin_prefetch(&tree.vrls()[node.representative]);
+            __builtin_prefetch(reinterpret_cast<const char*>(&tree.vrls()[node.representative]) + sizeof(Vrl) - 1);
             queued.push_back(i);
             scratch.bounds.push_back(b);
             if constexpr (kDeferred) scratch.states.push_back(d);
@@ -260,6 +271,7 @@ Rgb walkCut(const LightTree& tree, const CutSettings& settings, CutStatistics& s
                 }
             }
             total -= top.estimate;
+            prefetchNode(nodes[top.node].left), prefetchNode(nodes[top.node].right);
             if constexpr (kDeferred) {
                 pending.push_back({nodes[top.node].right, top.node, top.estimate, {top.state.factor, true}});
                 pending.push_back({nodes[top.node].left, top.node, top.estimate, {top.state.factor, true}});

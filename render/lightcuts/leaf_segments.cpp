@@ -47,11 +47,18 @@ size_t LeafSegments::memoryBytes() const {
     return bytes;
 }
 
-double LeafSegments::minDistanceToLine(int32_t node, const Vec3& origin, const Vec3& direction) const {
+SegmentLanes LeafSegments::lanesOf(int32_t node) const {
     const size_t first = first_[node];
-    const SegmentLanes lanes{lanes_[0].data() + first, lanes_[1].data() + first, lanes_[2].data() + first,
-                             lanes_[3].data() + first, lanes_[4].data() + first, lanes_[5].data() + first};
-    return minDistanceLineSegments(origin, direction, lanes, count(node));
+    return {lanes_[0].data() + first, lanes_[1].data() + first, lanes_[2].data() + first,
+            lanes_[3].data() + first, lanes_[4].data() + first, lanes_[5].data() + first};
+}
+
+double LeafSegments::minDistanceToLine(int32_t node, const Vec3& origin, const Vec3& direction) const {
+    return minDistanceLineSegments(origin, direction, lanesOf(node), count(node));
+}
+
+double LeafSegments::minDistanceToPoint(int32_t node, const Vec3& point) const {
+    return minDistancePointSegments(point, lanesOf(node), count(node));
 }
 
 }  // namespace vrl

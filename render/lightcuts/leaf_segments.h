@@ -6,6 +6,7 @@
 #pragma once
 
 #include "render/core/geometry.h"
+#include "render/core/segment_distances.h"
 #include "render/lightcuts/light_tree.h"
 
 #include <cstdint>
@@ -26,6 +27,9 @@ public:
     // The smallest distance from the line (origin, unit direction) to the VRLs below
     // `node`: distanceLineSegment's minimum, computed in SIMD lanes (segment_distances.h).
     double minDistanceToLine(int32_t node, const Vec3& origin, const Vec3& direction) const;
+    // The smallest distance from `point` to the VRLs below `node`: distancePointSegment's
+    // minimum, in SIMD lanes.
+    double minDistanceToPoint(int32_t node, const Vec3& point) const;
     size_t memoryBytes() const;
     // Per VRL: six float coordinates and a first-leaf index for each of its two nodes.
     static constexpr size_t kBytesPerVrl = 6 * sizeof(float) + 2 * sizeof(uint32_t);
@@ -38,6 +42,8 @@ public:
     }
 
 private:
+    SegmentLanes lanesOf(int32_t node) const;  // the node's VRLs, from its first
+
     const LightTree& tree_;
     std::vector<float> lanes_[6];  // x, y, z of the starts, of the ends; padded for the SIMD lanes
     std::vector<uint32_t> first_;  // per node: index of its first leaf

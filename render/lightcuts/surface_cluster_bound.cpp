@@ -106,11 +106,7 @@ std::optional<Rgb> SurfaceClusterBound::coneBoundTowardsBox(const CameraPathSurf
 double SurfaceClusterBound::minimumDistance(int32_t index, const Vec3& x) const {
     const LightTreeNode& node = tree_.nodes()[index];
     if (node.vrlCount > settings_.exactDistanceBelow) return distancePointBox(x, node.box);
-    double best = std::numeric_limits<double>::infinity();
-    const size_t first = leaves_->first(index), count = leaves_->count(index);
-    for (size_t k = first; k < first + count; ++k)
-        best = std::min(best, distancePointSegment(x, leaves_->start(k), leaves_->end(k)));
-    return best;
+    return leaves_->minDistanceToPoint(index, x);
 }
 
 Rgb SurfaceClusterBound::reflectionTowardsBox(const CameraPathSurface& x, const Bsdf& bsdf, const Imath::Box3f& box,
@@ -168,19 +164,21 @@ double SurfaceClusterBound::slackOf(const Imath::Box3f& box, const Vec3& p) {
     return 8.0 * 0x1p-24 * (double(p.length()) + reach);
 }
 
-Rgb SurfaceClusterBound::bound(int32_t index, const CameraPathSurface& x, bool* xInsideNode, Rgb* factor) const {
+Rgb SurfaceClusterBound::bound(int32_t index, const CameraPathSurface& x, bool* xInsideNode, Rgb* factor,
+                               const double* distance) const {
     const Imath::Box3f& box = tree_.nodes()[index].box;
     const double slack = slackOf(box, x.hit.position);
-    const double d = minimumDistance(index, x.hit.position) - slack;
+    const double d = distance ? *distance : minimumDistance(index, x.hit.position) - slack;
     if (xInsideNode) *xInsideNode = !(d > 0.0);
     return boundAt(index, x, d, slack, nullptr, factor);
 }
 
 Rgb SurfaceClusterBound::cheapBound(int32_t index, const CameraPathSurface& x, bool* xInsideNode,
-                                    const Rgb* inheritedGlossy, Rgb* factor, bool* tight) const {
+                                    const Rgb* inheritedGlossy, Rgb* factor, bool* tight, double* distance) const {
     const Vec3& p = x.hit.position;
     const double slack = slackOf(tree_.nodes()[index].box, p);
     const double d = minimumDistance(index, p) - slack;
+    if (distance) *distance = d;
     if (xInsideNode) *xInsideNode = !(d > 0.0);
     const bool glossyInherited = inheritedGlossy && !x.bsdf.lambertianBound().has_value();
     if (tight) *tight = !glossyInherited;

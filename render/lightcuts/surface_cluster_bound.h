@@ -68,7 +68,10 @@ public:
     // RGB bound for `node` lighting `x`; +infinity (and *xInsideNode = true) when
     // x lies in the node's box (or on one of a small node's segments).
     // *factor (optional): the receiver's factor f_s|cos| it used (below).
-    Rgb bound(int32_t node, const CameraPathSurface& x, bool* xInsideNode = nullptr, Rgb* factor = nullptr) const;
+    // `distance` (optional): the distance cheapBound gave for this node and x, which
+    // the bound then takes instead of computing it again.
+    Rgb bound(int32_t node, const CameraPathSurface& x, bool* xInsideNode = nullptr, Rgb* factor = nullptr,
+              const double* distance = nullptr) const;
     // A cheaper bound for the cut's deferred bounds (cut_walk.h); *tight says whether it
     // is the full one. For a glossy x, given `inheritedGlossy` (the factor of a box that
     // holds this node's box: its parent's), it takes that factor instead of its own: the
@@ -76,8 +79,9 @@ public:
     // factor stays proven, a heuristic one stays a heuristic. Elsewhere it is the full bound. (Deferring a small node's exact
     // distance as well, with the box's distance as the cheap one, made renders slower:
     // nearly every such node reached the heap's top and paid for both.)
+    // *distance (optional): the distance it used (after the rounding slack), for bound().
     Rgb cheapBound(int32_t node, const CameraPathSurface& x, bool* xInsideNode, const Rgb* inheritedGlossy,
-                   Rgb* factor, bool* tight) const;
+                   Rgb* factor, bool* tight, double* distance = nullptr) const;
     // The distance from x to the node used by the bound (box, or exact for small nodes).
     double minimumDistance(int32_t node, const Vec3& x) const;
     // Whether the bound is proven for the BSDF at x (Lambertian-bounded models; with

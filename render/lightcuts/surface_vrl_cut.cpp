@@ -3,7 +3,13 @@
 #include "render/lightcuts/cut_walk.h"
 #include "render/lightcuts/vrl_cut.h"
 
+#include <array>
+
 namespace vrl {
+
+namespace {
+constexpr size_t kDistanceSlots = 512;  // the visitor's cache of distances (below)
+}  // namespace
 
 SurfaceLightcutsEstimator::SurfaceLightcutsEstimator(const Scene& scene, const LightTree& tree,
                                                      const VrlSurfaceEstimator& estimator, CutSettings settings,
@@ -22,12 +28,22 @@ Rgb SurfaceLightcutsEstimator::estimate(const CameraPathSurface& x, uint64_t str
             Rng rng = vrlStream(streamKey, k);
             return self.estimator_.contribution(self.tree_.vrls()[k], x, rng);
         }
+        // The distances of nodes left with a cheap bound, for their tightening (a
+        // node's slot: its index modulo the size; a node found in another's slot
+        // computes its distance again). Nearly every node at a glossy x is tightened.
+        mutable std::array<int32_t, kDistanceSlots> distanceNode{};
+        mutable std::array<double, kDistanceSlots> distance{};
         bool bound(int32_t i, const Rgb* inherited, Rgb& b, Rgb& factor, bool& tight) const {
             bool inside = false;
-            b = self.bound_.cheapBound(i, x, &inside, inherited, &factor, &tight);
+            double d = 0.0;
+            b = self.bound_.cheapBound(i, x, &inside, inherited, &factor, &tight, &d);
+            if (!tight) distanceNode[size_t(i) % kDistanceSlots] = i, distance[size_t(i) % kDistanceSlots] = d;
             return !inside;
         }
-        void tighten(int32_t i, Rgb& b, Rgb& factor) const { b = self.bound_.bound(i, x, nullptr, &factor); }
+        void tighten(int32_t i, Rgb& b, Rgb& factor) const {
+            const size_t slot = size_t(i) % kDistanceSlots;
+            b = self.bound_.bound(i, x, nullptr, &factor, distanceNode[slot] == i ? &distance[slot] : nullptr);
+        }
         Rgb estimate(int32_t i) const {
             const LightTreeNode& node = self.tree_.nodes()[i];
             Vrl representative = self.tree_.vrls()[node.representative];
@@ -36,7 +52,9 @@ Rgb SurfaceLightcutsEstimator::estimate(const CameraPathSurface& x, uint64_t str
             return self.estimator_.contribution(representative, x, rng);
         }
     };
-    return walkCut(tree_, settings_, statistics, Visitor{*this, x, streamKey}, otherLuminance);
+    Visitor visitor{*this, x, streamKey, {}, {}};
+    visitor.distanceNode.fill(-1);
+    return walkCut(tree_, settings_, statistics, visitor, otherLuminance);
 }
 
 }  // namespace vrl

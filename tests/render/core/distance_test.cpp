@@ -4,13 +4,18 @@
 // (a zero direction component) and of zero length. The exact minimum can only be
 // below the sampled one, and above it by no more than the sampling step (the
 // distance is 1-Lipschitz along the line).
+// The SIMD minima over many segments (segment_distances.h) against the scalar
+// loops they replace, bit for bit.
 #include "render/core/distance.h"
+#include "render/core/segment_distances.h"
 
 #include "render/core/rng.h"
 
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
+#include <vector>
 
 namespace vrl {
 namespace {
@@ -52,6 +57,40 @@ TEST(DistancesSegmentBox, MatchBruteForce) {
     EXPECT_NEAR(distancesSegmentBox(Vec3(-3.0f, 0.5f, 0.5f), Vec3(1.0f, 0.0f, 0.0f), 1.0, unit).segment, 2.0, 1e-12);
     EXPECT_EQ(distancesSegmentBox(Vec3(-3.0f, 0.5f, 0.5f), Vec3(1.0f, 0.0f, 0.0f), 1.0, unit).line, 0.0);
     EXPECT_TRUE(std::isinf(distancesSegmentBox(Vec3(0.0f), Vec3(1.0f, 0.0f, 0.0f), 1.0, Imath::Box3f()).segment));
+}
+
+// Every count from 0 to 19 (whole SIMD vectors and every remainder), random
+// segments around the query, some of zero length, some through the query point or
+// on the line; the lanes past `count` hold a segment through the query, which must
+// be ignored.
+TEST(SegmentLanes, MinimaEqualTheScalarLoopsBitForBit) {
+    Rng rng(11, 0);
+    const auto coordinate = [&] { return 4.0f * rng.next() - 2.0f; };
+    for (int trial = 0; trial < 400; ++trial) {
+        const size_t count = size_t(trial % 20);
+        const Vec3 point(coordinate(), coordinate(), coordinate());
+        const Vec3 direction = Vec3(coordinate(), coordinate(), coordinate()).normalized();
+        std::vector<float> lanes[6];
+        for (auto& lane : lanes) lane.assign(count + kSegmentLanesPadding, 0.0f);
+        for (size_t k = 0; k < count + kSegmentLanesPadding; ++k) {
+            Vec3 a(coordinate(), coordinate(), coordinate()), b(coordinate(), coordinate(), coordinate());
+            if (k >= count) a = b = point;  // padding: would be the minimum if it were read
+            else if (k % 5 == 1) b = a;     // zero length
+            else if (k % 7 == 3) a = point; // through the query point
+            else if (k % 9 == 4) a = point + direction * 0.5f, b = point - direction * 0.25f;  // on the line
+            for (int c = 0; c < 3; ++c) lanes[c][k] = a[c], lanes[3 + c][k] = b[c];
+        }
+        const SegmentLanes segments{lanes[0].data(), lanes[1].data(), lanes[2].data(),
+                                    lanes[3].data(), lanes[4].data(), lanes[5].data()};
+        double toPoint = std::numeric_limits<double>::infinity(), toLine = toPoint;
+        for (size_t k = 0; k < count; ++k) {
+            const Vec3 a(lanes[0][k], lanes[1][k], lanes[2][k]), b(lanes[3][k], lanes[4][k], lanes[5][k]);
+            toPoint = std::min(toPoint, distancePointSegment(point, a, b));
+            toLine = std::min(toLine, distanceLineSegment(point, direction, a, b));
+        }
+        EXPECT_EQ(minDistancePointSegments(point, segments, count), toPoint) << trial;
+        EXPECT_EQ(minDistanceLineSegments(point, direction, segments, count), toLine) << trial;
+    }
 }
 
 }  // namespace
