@@ -473,8 +473,12 @@ TileSums TileShader::shadeTile(const TileRect& tile, int firstPass, int passCoun
                 for (int m = 0; m < points; ++m) {
                     Rng rng(settings_.seed, Rng::combine(pixel, kPixelLightsSample - uint64_t(m)));
                     const Ray ray = stratifiedCameraRay(camera, settings_, x, y, m % side, m / side, side, rng);
-                    const auto one =
-                        integrator_->virtualLightParts(ray, rng, &cut, &surfaceCut, firstSampleLuminance, &surfaceVplCut);
+                    // The point's stratum: (c)'s textures are averaged over it (pixel_footprint.h).
+                    const float stratum = 1.0f / float(side);
+                    const FilmSquare square{float(x + camera.cropX0()) + float(m % side) * stratum,
+                                            float(y + camera.cropY0()) + float(m / side) * stratum, stratum};
+                    const auto one = integrator_->virtualLightParts(ray, rng, &cut, &surfaceCut, firstSampleLuminance,
+                                                                    &surfaceVplCut, &square);
                     if (m == 0) {
                         lit = one;
                         continue;

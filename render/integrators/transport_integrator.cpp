@@ -133,7 +133,8 @@ TransportIntegrator::VirtualLightParts TransportIntegrator::virtualLightParts(co
                                                                            CutStatistics* multipleStatistics,
                                                                            CutStatistics* surfaceStatistics,
                                                                            float pathLuminance,
-                                                                           CutStatistics* surfaceVplStatistics) const {
+                                                                           CutStatistics* surfaceVplStatistics,
+                                                                           const FilmSquare* pixel) const {
     VirtualLightParts parts;
     const bool multiple = settings_.transports.has(TransportPart::Multiple);
     const bool surface = vrlLitSurfaces() && settings_.transports.has(TransportPart::MediumSurface);
@@ -143,7 +144,11 @@ TransportIntegrator::VirtualLightParts TransportIntegrator::virtualLightParts(co
     // from (key, k) in both plain and Lightcuts shading, so the two differ only by
     // the cut's approximation.
     const uint64_t pixelKey = (uint64_t(rng.nextUint()) << 32) | rng.nextUint();
-    const CameraPath path = cameraPath(scene_, cameraRay, scene_.cameraMedium(), &rng, settings_.maxDepth);
+    CameraPath path = cameraPath(scene_, cameraRay, scene_.cameraMedium(), &rng, settings_.maxDepth);
+    if (pixel && surface && path.surface && path.surface->specularBefore == 0 &&
+        scene_.shapes()[path.surface->hit.shape].bsdf.isTextured())
+        if (const auto uvs = footprintTexcoords(scene_, *pixel, path.surface->hit))
+            path.surface->bsdf.averageTexturesOver(*uvs);
     // (d) first: (c)'s cut measures its error against the pixel's other parts. (d)'s own
     // cuts measure theirs against their total and the path-sampled parts (Lightcuts'
     // error relative to the pixel; the paper's media-only images have only (d)).

@@ -46,6 +46,7 @@
 #pragma once
 
 #include "render/integrators/path_tracer.h"
+#include "render/integrators/pixel_footprint.h"
 #include "render/integrators/transport_parts.h"
 #include "render/lightcuts/light_tree.h"
 #include "render/lightcuts/vpl_cut.h"
@@ -99,9 +100,13 @@ public:
     struct VirtualLightParts {
         Rgb mediumSurface{0.0f}, multiple{0.0f}, singleSurface{0.0f};
     };
+    // `pixel`: the film square the call stands for, when it is evaluated once for it
+    // (once per pixel, or per shading point): the surface point of (c) then takes its
+    // textures' mean over that square (pixel_footprint.h). Null: the point's own lookups.
     VirtualLightParts virtualLightParts(const Ray& cameraRay, Rng& rng, CutStatistics* multipleStatistics = nullptr,
                                         CutStatistics* surfaceStatistics = nullptr, float pathLuminance = 0.0f,
-                                        CutStatistics* surfaceVplStatistics = nullptr) const;
+                                        CutStatistics* surfaceVplStatistics = nullptr,
+                                        const FilmSquare* pixel = nullptr) const;
 
     // Part (b)'s non-Dirac surface light comes from surface VPLs (virtualLightParts' singleSurface).
     bool surfaceVplsLight() const { return surfaceVpls_ != nullptr && surfaceVplsSingle_; }

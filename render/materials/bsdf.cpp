@@ -337,6 +337,23 @@ PreparedBsdf Bsdf::prepare(const ShadingPoint& sp, const Vec3& wo) const {
     return prepared;
 }
 
+bool Bsdf::isTextured() const {
+    return !reflectance_.isConstant() || !specularReflectance_.isConstant() || !specularTransmittance_.isConstant();
+}
+
+void PreparedBsdf::averageTexturesOver(std::span<const Vec2> uvs) {
+    if (!bsdf_ || uvs.empty() || !bsdf_->isTextured()) return;
+    Rgb diffuse(0.0f), specular(0.0f), transmission(0.0f);
+    for (const Vec2& uv : uvs) {
+        const BsdfLookups l = bsdf_->lookups(uv, setup_.woLocal);
+        diffuse += l.diffuse, specular += l.specular, transmission += l.transmission;
+    }
+    const float inverse = 1.0f / float(uvs.size());
+    lookups_.diffuse = diffuse * inverse;
+    lookups_.specular = specular * inverse;
+    lookups_.transmission = transmission * inverse;
+}
+
 Rgb PreparedBsdf::eval(const Vec3& wi, TransportMode mode) const {
     if (!bsdf_) return Rgb(0.0f);
     const Vec3 wiLocal = setup_.frame.toLocal(wi);

@@ -122,6 +122,13 @@ public:
     // Float evaluation of those terms is covered by a 1.0001 factor (relative
     // errors of a few float steps); rounding of the caller's directions belongs in beta.
     std::optional<Rgb> coneBound(const Vec3& axis, double halfAngle) const;
+    // Replaces the texture lookups with their mean over `uvs`, keeping this point's
+    // geometry (frame, wo): eval is linear in the lookups, so eval(wi) becomes the mean
+    // of the evaluations at those texture coordinates, and the bounds above follow it
+    // (they read the same lookups). For a point shaded once for a whole pixel, whose
+    // texture would otherwise be sampled at one place (pixel_footprint.h). No effect
+    // where nothing was prepared, on models without textures, or for empty `uvs`.
+    void averageTexturesOver(std::span<const Vec2> uvs);
 
 private:
     friend class Bsdf;
@@ -146,6 +153,8 @@ public:
     // emission found after sampling it.
     bool hasSpecular() const;
     bool twoSided() const { return twoSided_; }
+    // Some colour parameter is a texture (its lookups depend on uv).
+    bool isTextured() const;
 
     Rgb eval(const ShadingPoint& sp, const Vec3& wo, const Vec3& wi, TransportMode mode) const;
     PreparedBsdf prepare(const ShadingPoint& sp, const Vec3& wo) const;

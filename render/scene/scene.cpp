@@ -321,6 +321,21 @@ std::optional<SurfaceHit> Scene::intersect(const Ray& ray) const {
     return hit;
 }
 
+Vec2 Scene::texcoordOnPlane(const SurfaceHit& hit, const Vec3& point) const {
+    const TriangleMesh& mesh = shapes_[hit.shape].mesh;
+    const auto& tri = mesh.triangles[hit.triangle];
+    // Barycentrics (u, v) of the projection: least squares of point - p0 = u e1 + v e2.
+    const Imath::V3d p0(mesh.positions[tri[0]]);
+    const Imath::V3d e1 = Imath::V3d(mesh.positions[tri[1]]) - p0, e2 = Imath::V3d(mesh.positions[tri[2]]) - p0;
+    const Imath::V3d w = Imath::V3d(point) - p0;
+    const double d11 = e1.dot(e1), d12 = e1.dot(e2), d22 = e2.dot(e2);
+    const double determinant = d11 * d22 - d12 * d12;
+    if (!(determinant > 1e-12 * d11 * d22)) return hit.uv;
+    const double b1 = w.dot(e1), b2 = w.dot(e2);
+    const double u = (d22 * b1 - d12 * b2) / determinant, v = (d11 * b2 - d12 * b1) / determinant;
+    return mesh.texcoord(hit.triangle, float(u), float(v));
+}
+
 bool Scene::occluded(const Ray& ray) const {
     if (shapes_.empty()) return false;
     RTCIntersectContext context;

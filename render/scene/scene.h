@@ -75,6 +75,10 @@ public:
 
     // Closest surface along the ray within (0, ray.tMax).
     std::optional<SurfaceHit> intersect(const Ray& ray) const;
+    // The texture coordinates the hit triangle's linear uv map gives `point`, taken on
+    // the triangle's plane (its projection there; outside the triangle the map is
+    // extended linearly). hit.uv where the triangle is degenerate.
+    Vec2 texcoordOnPlane(const SurfaceHit& hit, const Vec3& point) const;
     // True if any surface blocks the segment (origin, origin + t direction), t < tMax.
     bool occluded(const Ray& ray) const;
     // No surface between two points (stopping 1e-4 of the distance short of `to`, so

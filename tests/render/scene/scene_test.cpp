@@ -87,6 +87,35 @@ TEST(SceneTest, IntersectFindsTheCubeFaces) {
     EXPECT_FALSE(scene->intersect(Ray{Vec3(3, 0, 0), Vec3(0, 0, 1)}));  // passes beside it
 }
 
+// The rectangle's uv map is u = (x + 1) / 2, v = (1 - y) / 2 in its own frame
+// (shape_mesh.h: Mitsuba's v, flipped to Texture's bottom-row convention), linear over its whole plane: texcoordOnPlane must give it for points
+// of the plane inside the hit triangle, in the other triangle, beyond the rectangle,
+// and for points off the plane (their projection).
+TEST(SceneTest, TexcoordOnPlaneExtendsTheHitTrianglesUvMap) {
+    auto d = emptyScene();
+    const Transform toWorld =
+        Transform::scale(Vec3(2.0f, 3.0f, 1.0f)).then(Transform::rotate(Vec3(1, 0, 0), 50.0f)).then(
+            Transform::translate(Vec3(0.5f, -0.25f, 6.0f)));
+    d.shapes.push_back(shape(Kind::Rectangle, toWorld));
+    const auto scene = Scene::build(d);
+    const auto hit = scene->intersect(Ray{Vec3(0, 0, 0), Vec3(0.05f, -0.02f, 1.0f).normalized()});
+    ASSERT_TRUE(hit);
+    const Vec3 normal = toWorld.applyNormal(Vec3(0, 0, 1)).normalized();
+    for (const Vec2& local : {Vec2(0.3f, -0.6f), Vec2(-0.7f, 0.8f), Vec2(0.9f, 0.9f), Vec2(2.5f, -1.7f),
+                             Vec2(-3.0f, 0.1f)}) {
+        for (const float offset : {0.0f, 0.4f, -1.3f}) {
+            const Vec3 point = toWorld.applyPoint(Vec3(local.x, local.y, 0.0f)) + normal * offset;
+            const Vec2 uv = scene->texcoordOnPlane(*hit, point);
+            EXPECT_NEAR(uv.x, 0.5f * (local.x + 1.0f), 2e-5f) << local << " offset " << offset;
+            EXPECT_NEAR(uv.y, 0.5f * (1.0f - local.y), 2e-5f) << local << " offset " << offset;
+        }
+    }
+    // At the hit itself: the hit's own uv.
+    const Vec2 own = scene->texcoordOnPlane(*hit, hit->position);
+    EXPECT_NEAR(own.x, hit->uv.x, 1e-5f);
+    EXPECT_NEAR(own.y, hit->uv.y, 1e-5f);
+}
+
 // A cube [-1, 1]^3 with a null boundary around an absorbing, scattering medium.
 SceneDescription mediumCube(const Rgb& sigmaS, const Rgb& sigmaA) {
     auto d = emptyScene();
