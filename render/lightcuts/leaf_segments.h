@@ -22,8 +22,6 @@ public:
     // The VRLs below `node` are k in [first(node), first(node) + count(node)).
     size_t first(int32_t node) const { return first_[node]; }
     size_t count(int32_t node) const { return tree_.nodes()[node].vrlCount; }
-    Vec3 start(size_t k) const { return {lanes_[0][k], lanes_[1][k], lanes_[2][k]}; }
-    Vec3 end(size_t k) const { return {lanes_[3][k], lanes_[4][k], lanes_[5][k]}; }
     // The smallest distance from the line (origin, unit direction) to the VRLs below
     // `node`: distanceLineSegment's minimum, computed in SIMD lanes (segment_distances.h).
     double minDistanceToLine(int32_t node, const Vec3& origin, const Vec3& direction) const;
