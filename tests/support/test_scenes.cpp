@@ -23,6 +23,15 @@ SensorDescription cameraAtOrigin(int width, int height, float fovDegrees) {
     return sensor;
 }
 
+SceneDescription cameraAndFarLight(int width, int height, float fovDegrees) {
+    SceneDescription d;
+    d.sensor = cameraAtOrigin(width, height, fovDegrees);
+    EmitterDescription light;
+    light.toWorld = Transform::translate(Vec3(0, 50, 0));
+    d.emitters.push_back(light);
+    return d;
+}
+
 SceneDescription emittingSphereFurnace(const Rgb& radiance, const Rgb& sigmaS, float g, const Rgb& wallReflectance) {
     SceneDescription scene;
     scene.sensor = cameraAtOrigin(8, 8, 90.0f);

@@ -23,6 +23,10 @@ inline BsdfDescription nullBsdf() {
 // A camera at the origin looking down +z with the given film and fov.
 SensorDescription cameraAtOrigin(int width, int height, float fovDegrees);
 
+// cameraAtOrigin and a point light far above (y = 50), nothing else: a base for
+// geometry tests (the light only keeps Scene::build from warning).
+SceneDescription cameraAndFarLight(int width, int height, float fovDegrees);
+
 // Closed sphere (radius 1, centred on the camera) emitting `radiance` inwards,
 // diffuse walls of `wallReflectance` (default black), filled with a non-absorbing
 // medium of scattering `sigmaS`: every pixel's expected radiance is exactly

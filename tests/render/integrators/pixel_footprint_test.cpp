@@ -13,11 +13,7 @@ namespace vrl {
 namespace {
 
 SceneDescription tiltedRectangle(const Transform& toWorld) {
-    SceneDescription d;
-    d.sensor = test::cameraAtOrigin(32, 24, 40.0f);
-    EmitterDescription light;
-    light.toWorld = Transform::translate(Vec3(0, 50, 0));
-    d.emitters.push_back(light);
+    SceneDescription d = test::cameraAndFarLight(32, 24, 40.0f);
     ShapeDescription rectangle;
     rectangle.kind = ShapeDescription::Kind::Rectangle;
     rectangle.toWorld = toWorld;

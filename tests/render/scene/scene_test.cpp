@@ -43,14 +43,7 @@ MediumDescription medium(const std::string& id, const Rgb& sigmaS, const Rgb& si
 }
 
 // No shapes or media; a point light far away only keeps Scene::build from warning.
-SceneDescription emptyScene() {
-    SceneDescription d;
-    d.sensor = test::cameraAtOrigin(4, 4, 45.0f);
-    EmitterDescription light;
-    light.toWorld = Transform::translate(Vec3(0, 50, 0));
-    d.emitters.push_back(light);
-    return d;
-}
+SceneDescription emptyScene() { return test::cameraAndFarLight(4, 4, 45.0f); }
 
 void expectRgbNear(const Rgb& actual, const Rgb& expected, float relative) {
     for (int c = 0; c < 3; ++c) EXPECT_NEAR(actual[c], expected[c], relative * expected[c]) << "channel " << c;
