@@ -338,6 +338,8 @@ TileShader::TileShader(const Scene& scene, const RenderSettings& settings, const
         integratorSettings.vplDistanceSamples = settings.vplDistanceSamples;
         integratorSettings.stochastic = settings.method == RenderMethod::VrlStochastic;
         integratorSettings.surfaceVplCut = lightcuts;
+        // (c) once per pixel over interleaved points of the pixel; at pixel centres, the centre's alone.
+        integratorSettings.surfacePointsSide = settings.jitter ? kInterleavedPointsSide : 1;
         integrator_ = std::make_unique<TransportIntegrator>(scene, lights.vrls, integratorSettings,
                                                       lightcuts && lights.tree.root() >= 0 ? &lights.tree : nullptr,
                                                       usesSurfaceVpls(settings) ? &lights.surfaceVpls : nullptr);

@@ -3,6 +3,8 @@
 #include <spdlog/spdlog.h>
 
 #include <cmath>
+#include <optional>
+#include <stdexcept>
 
 namespace vrl {
 
@@ -145,10 +147,6 @@ TransportIntegrator::VirtualLightParts TransportIntegrator::virtualLightParts(co
     // the cut's approximation.
     const uint64_t pixelKey = (uint64_t(rng.nextUint()) << 32) | rng.nextUint();
     CameraPath path = cameraPath(scene_, cameraRay, scene_.cameraMedium(), &rng, settings_.maxDepth);
-    if (pixel && surface && path.surface && path.surface->specularBefore == 0 &&
-        scene_.shapes()[path.surface->hit.shape].bsdf.isTextured())
-        if (const auto uvs = footprintTexcoords(scene_, *pixel, path.surface->hit))
-            path.surface->bsdf.averageTexturesOver(*uvs);
     // (d) first: (c)'s cut measures its error against the pixel's other parts. (d)'s own
     // cuts measure theirs against their total and the path-sampled parts (Lightcuts'
     // error relative to the pixel; the paper's media-only images have only (d)).
@@ -172,10 +170,17 @@ TransportIntegrator::VirtualLightParts TransportIntegrator::virtualLightParts(co
             parts.multiple += estimator_.sumOverVrls(*plainLanes_, segment, streamKey);
         }
     }
-    if (surface && path.surface)
-        parts.mediumSurface = vrlLitSurface(*path.surface, Rng::combine(pixelKey, ~uint64_t(0)),
-                                            surfaceStatistics ? *surfaceStatistics : unused,
-                                            pathLuminance + std::max(0.0f, luminance(parts.multiple)));
+    if (surface) {
+        CutStatistics& statistics = surfaceStatistics ? *surfaceStatistics : unused;
+        const float other = pathLuminance + std::max(0.0f, luminance(parts.multiple));
+        if (pixel && settings_.surfacePointsSide > 1 && !stochastic_) {
+            parts.mediumSurface = interleavedSurface(*pixel, pixelKey, statistics, other);
+        } else if (path.surface) {
+            if (pixel) averageTextures(*path.surface, *pixel);
+            parts.mediumSurface = vrlLitSurface(InterleavedPoints::single(*path.surface), *path.surface,
+                                                Rng::combine(pixelKey, ~uint64_t(0)), statistics, other);
+        }
+    }
     // (b)'s surface light from the VPLs, last: its cut measures its error against the pixel's other parts.
     if (surfaceVpls_ && surfaceVplsSingle_) {
         const float other = pathLuminance + std::max(0.0f, luminance(parts.multiple)) +
@@ -212,19 +217,61 @@ Rgb TransportIntegrator::surfaceVplsAtSurface(const Ray& cameraRay, Rng& rng) co
     return surfaceVplLightcuts_->sample(*path.surface, surfaceVplRadius_, kSurfaceVplSamples, rng, unused);
 }
 
-Rgb TransportIntegrator::vrlLitSurface(const CameraPathSurface& x, uint64_t streamKey, CutStatistics& statistics,
-                                       float otherLuminance) const {
-    if (settings_.maxDepth >= 0 && settings_.maxDepth < x.specularBefore + 3) return Rgb(0.0f);
-    if (surfaceLightcuts_) return surfaceLightcuts_->estimate(x, streamKey, statistics, otherLuminance);
+void TransportIntegrator::averageTextures(CameraPathSurface& x, const FilmSquare& square) const {
+    if (x.specularBefore != 0 || !scene_.shapes()[x.hit.shape].bsdf.isTextured()) return;
+    if (const auto uvs = footprintTexcoords(scene_, square, x.hit)) x.bsdf.averageTexturesOver(*uvs);
+}
+
+Rgb TransportIntegrator::interleavedSurface(const FilmSquare& square, uint64_t pixelKey, CutStatistics& statistics,
+                                            float otherLuminance) const {
+    const int side = settings_.surfacePointsSide;
+    const uint32_t count = uint32_t(side * side);
+    if (count > InterleavedPoints::kMaxPoints) throw std::logic_error("interleavedSurface: too many points");
+    // The points' own stream (jitter, specular choices, o and the cut point), apart from
+    // the pixel's other draws.
+    Rng rng = vrlStream(Rng::combine(pixelKey, ~uint64_t(1)), 0);
+    std::array<std::optional<CameraPathSurface>, InterleavedPoints::kMaxPoints> surfaces;
+    InterleavedPoints points;
+    points.count = count;
+    const float stratum = square.size / float(side);
+    for (uint32_t q = 0; q < count; ++q) {
+        const float x0 = square.x + float(q % uint32_t(side)) * stratum;
+        const float y0 = square.y + float(q / uint32_t(side)) * stratum;
+        const float jx = rng.next(), jy = rng.next();
+        const Ray ray = scene_.camera().generateRay(x0 + jx * stratum, y0 + jy * stratum);
+        CameraPath path = cameraPath(scene_, ray, scene_.cameraMedium(), &rng, settings_.maxDepth);
+        if (!path.surface) continue;
+        // Past the depth limit the point has no (c) (as vrlLitSurface's single point).
+        if (settings_.maxDepth >= 0 && settings_.maxDepth < path.surface->specularBefore + 3) continue;
+        surfaces[q] = std::move(path.surface);
+        averageTextures(*surfaces[q], FilmSquare{x0, y0, stratum});
+        points.points[q] = &*surfaces[q];
+    }
+    // o, then the cut point: the first point present from a start drawn apart from o.
+    points.offset = std::min(count - 1, uint32_t(rng.next() * float(count)));
+    const uint32_t start = std::min(count - 1, uint32_t(rng.next() * float(count)));
+    for (uint32_t n = 0; n < count; ++n)
+        if (const CameraPathSurface* cutPoint = points.points[(start + n) % count])
+            return vrlLitSurface(points, *cutPoint, Rng::combine(pixelKey, ~uint64_t(0)), statistics, otherLuminance);
+    return Rgb(0.0f);
+}
+
+Rgb TransportIntegrator::vrlLitSurface(const InterleavedPoints& points, const CameraPathSurface& cutPoint,
+                                       uint64_t streamKey, CutStatistics& statistics, float otherLuminance) const {
+    if (points.count == 1 && settings_.maxDepth >= 0 && settings_.maxDepth < cutPoint.specularBefore + 3)
+        return Rgb(0.0f);
+    if (surfaceLightcuts_) return surfaceLightcuts_->estimate(points, cutPoint, streamKey, statistics, otherLuminance);
     if (stochastic_) {
         Rng rng = vrlStream(streamKey, ~0u);
-        return stochastic_->estimate(x, rng, statistics);
+        return stochastic_->estimate(cutPoint, rng, statistics);
     }
     Rgb sum(0.0f);
     const auto& vrls = tree_ ? tree_->vrls() : vrls_.vrls;
     for (uint32_t k = 0; k < vrls.size(); ++k) {
+        const CameraPathSurface* x = points.at(k);
+        if (!x) continue;
         Rng vrlRng = vrlStream(streamKey, k);
-        sum += surfaceEstimator_.contribution(vrls[k], x, vrlRng);
+        sum += surfaceEstimator_.contribution(vrls[k], *x, vrlRng);
     }
     return sum;
 }

@@ -32,8 +32,10 @@
 //       (PathStart::diracAtFirstSurfaceOnly), the complement;
 //   (c) x1 on a surface, x2 in a medium: VRL-lit surfaces: every VRL
 //       (VrlSurfaceEstimator), a cut through the VRL tree (surface_vrl_cut.h)
-//       or a stochastic cut (stochastic_vrl_cut.h) at x1; the VPL methods
-//       path-trace it (their lights are points);
+//       or a stochastic cut (stochastic_vrl_cut.h) at x1; once per pixel with
+//       jittered rays, the VRLs are interleaved over 2 x 2 points x1 of the
+//       pixel instead (interleaved_points.h); the VPL methods path-trace it
+//       (their lights are points);
 //   (d) x1 and x2 in media: every VRL (--method vrl), a cut (vrl-lightcuts) or
 //       a stochastic cut (vrl-stochastic) against each camera segment, or VPLs
 //       gathered at distance samples (vpl, vpl-lightcuts).
@@ -54,6 +56,7 @@
 #include "render/lightcuts/surface_vpl_cut.h"
 #include "render/lightcuts/surface_vrl_cut.h"
 #include "render/lightcuts/vrl_cut.h"
+#include "render/vrl/interleaved_points.h"
 #include "render/vrl/vrl.h"
 #include "render/vrl/vrl_estimator.h"
 #include "render/vrl/vrl_surface_estimator.h"
@@ -76,7 +79,15 @@ struct TransportIntegratorSettings {
     // (b)'s surface VPLs by a cut over their tree (vrl-lightcuts), else every VPL; part
     // (a) samples them down that tree in both.
     bool surfaceVplCut = false;
+    // Part (c) once per film square (virtualLightParts' `pixel`): the VRLs interleaved over
+    // side x side stratified points of the square (interleaved_points.h); 1: at the camera
+    // ray's own surface point. The renderer takes kInterleavedPointsSide with jittered
+    // rays, 1 at pixel centres.
+    int surfacePointsSide = 1;
 };
+
+// Part (c)'s interleaved points per side of a pixel (or of a shading point's stratum).
+inline constexpr int kInterleavedPointsSide = 2;
 
 class TransportIntegrator {
 public:
@@ -101,8 +112,11 @@ public:
         Rgb mediumSurface{0.0f}, multiple{0.0f}, singleSurface{0.0f};
     };
     // `pixel`: the film square the call stands for, when it is evaluated once for it
-    // (once per pixel, or per shading point): the surface point of (c) then takes its
-    // textures' mean over that square (pixel_footprint.h). Null: the point's own lookups.
+    // (once per pixel, or per shading point): (c) then interleaves its VRLs over
+    // settings.surfacePointsSide^2 points of the square (interleaved_points.h), each
+    // with its textures' mean over its stratum (pixel_footprint.h), or with one point
+    // (side 1), the ray's own, its textures averaged over the square. Null: the ray's
+    // own point and lookups.
     VirtualLightParts virtualLightParts(const Ray& cameraRay, Rng& rng, CutStatistics* multipleStatistics = nullptr,
                                         CutStatistics* surfaceStatistics = nullptr, float pathLuminance = 0.0f,
                                         CutStatistics* surfaceVplStatistics = nullptr,
@@ -129,8 +143,14 @@ private:
     Rgb mediumToSurface(const CameraSegment& segment, Rng& rng) const;
     // Part (a)'s light from the surface VPLs at this camera sample's x1.
     Rgb surfaceVplsAtSurface(const Ray& cameraRay, Rng& rng) const;
-    Rgb vrlLitSurface(const CameraPathSurface& x, uint64_t streamKey, CutStatistics& statistics,
-                      float otherLuminance) const;
+    // (c) over `points`, the cut (if any) chosen at `cutPoint`, one of them.
+    Rgb vrlLitSurface(const InterleavedPoints& points, const CameraPathSurface& cutPoint, uint64_t streamKey,
+                      CutStatistics& statistics, float otherLuminance) const;
+    // (c) over surfacePointsSide^2 stratified points of `square`, from streams keyed by pixelKey.
+    Rgb interleavedSurface(const FilmSquare& square, uint64_t pixelKey, CutStatistics& statistics,
+                           float otherLuminance) const;
+    // The point's BSDF takes its textures' mean over `square` (a point the camera sees directly).
+    void averageTextures(CameraPathSurface& x, const FilmSquare& square) const;
 
     const Scene& scene_;
     const VrlSet& vrls_;

@@ -18,15 +18,29 @@ SurfaceLightcutsEstimator::SurfaceLightcutsEstimator(const Scene& scene, const L
 
 Rgb SurfaceLightcutsEstimator::estimate(const CameraPathSurface& x, uint64_t streamKey, CutStatistics& statistics,
                                         float otherLuminance) const {
+    return estimate(InterleavedPoints::single(x), x, streamKey, statistics, otherLuminance);
+}
+
+Rgb SurfaceLightcutsEstimator::estimate(const InterleavedPoints& points, const CameraPathSurface& x,
+                                        uint64_t streamKey, CutStatistics& statistics, float otherLuminance) const {
     if (tree_.empty()) return Rgb(0.0f);
     struct Visitor {
         const SurfaceLightcutsEstimator& self;
-        const CameraPathSurface& x;
+        const InterleavedPoints& points;
+        const CameraPathSurface& x;  // the cut point: every bound is taken here
         uint64_t streamKey;
+        // VRL k (with `flux`) at its interleaved point, from its own stream.
+        Rgb at(uint32_t k, const Rgb& flux) const {
+            const CameraPathSurface* point = points.at(k);
+            if (!point) return Rgb(0.0f);
+            Vrl vrl = self.tree_.vrls()[k];
+            vrl.flux = flux;
+            Rng rng = vrlStream(streamKey, k);
+            return self.estimator_.contribution(vrl, *point, rng);
+        }
         Rgb leaf(int32_t i) const {
             const uint32_t k = self.tree_.nodes()[i].representative;
-            Rng rng = vrlStream(streamKey, k);
-            return self.estimator_.contribution(self.tree_.vrls()[k], x, rng);
+            return at(k, self.tree_.vrls()[k].flux);
         }
         // The distances of nodes left with a cheap bound, for their tightening (a
         // node's slot: its index modulo the size; a node found in another's slot
@@ -46,13 +60,14 @@ Rgb SurfaceLightcutsEstimator::estimate(const CameraPathSurface& x, uint64_t str
         }
         Rgb estimate(int32_t i) const {
             const LightTreeNode& node = self.tree_.nodes()[i];
-            Vrl representative = self.tree_.vrls()[node.representative];
-            representative.flux = node.clusterFlux;
-            Rng rng = vrlStream(streamKey, node.representative);
-            return self.estimator_.contribution(representative, x, rng);
+            return at(node.representative, node.clusterFlux);
+        }
+        // Only an estimate made where the bound was taken can be held against it.
+        bool estimatedAtBoundPoint(int32_t i) const {
+            return points.count == 1 || points.at(self.tree_.nodes()[i].representative) == &x;
         }
     };
-    Visitor visitor{*this, x, streamKey, {}, {}};
+    Visitor visitor{*this, points, x, streamKey, {}, {}};
     visitor.distanceNode.fill(-1);
     return walkCut(tree_, settings_, statistics, visitor, otherLuminance);
 }

@@ -7,11 +7,14 @@
 // small share of a surface pixel, and the paper's error is relative to the
 // pixel). A node whose box holds x has no bound and is
 // refined without being estimated (#Inter); leaves are single VRLs.
+// Over interleaved points (interleaved_points.h) the bounds are taken at the cut
+// point and each node is estimated at its representative's point.
 #pragma once
 
 #include "render/lightcuts/cut_settings.h"
 #include "render/lightcuts/light_tree.h"
 #include "render/lightcuts/surface_cluster_bound.h"
+#include "render/vrl/interleaved_points.h"
 #include "render/vrl/vrl_surface_estimator.h"
 
 #include <cstdint>
@@ -31,6 +34,11 @@ public:
     // the pixel's other parts (cut_walk.h).
     Rgb estimate(const CameraPathSurface& x, uint64_t streamKey, CutStatistics& statistics,
                  float otherLuminance = 0.0f) const;
+    // The same over interleaved points: the cut chosen with bounds at `cutPoint` (one of
+    // `points`), node n estimated at points.at(its representative). boundExceeded and
+    // boundedEstimates count only the nodes estimated at the cut point.
+    Rgb estimate(const InterleavedPoints& points, const CameraPathSurface& cutPoint, uint64_t streamKey,
+                 CutStatistics& statistics, float otherLuminance = 0.0f) const;
 
 private:
     const LightTree& tree_;

@@ -93,17 +93,21 @@ void expectAgree(const RunStatistics& vrl, const RunStatistics& reference, const
     EXPECT_LT(vrl.standardError[image][1], 0.05f * test::kSanitizedNoiseFactor * reference.mean[image][1]) << what << ": too noisy to mean much";
 }
 
+// `jittered`: each sample's ray through a uniform point of its pixel (the pixel's mean), else its centre.
 RunStatistics referenceRuns(const Scene& scene, int spp, bool onlyMediumToMedium, int maxDepth = -1,
-                            const PathStart& start = {}) {
+                            const PathStart& start = {}, bool jittered = false) {
     return overRuns([&](uint64_t seed) {
         Image image(scene.camera().width(), scene.camera().height());
         const VolumetricPathTracer tracer(scene, PathTracerSettings{maxDepth, 5, onlyMediumToMedium});
         tbb::parallel_for(0, image.height(), [&](int y) {
             for (int x = 0; x < image.width(); ++x) {
                 Rng rng(seed * 7919, uint64_t(y * image.width() + x));
-                const Ray ray = scene.camera().generateRay(x + 0.5f, y + 0.5f);
+                const Ray centre = scene.camera().generateRay(x + 0.5f, y + 0.5f);
                 Rgb sum(0.0f);
-                for (int s = 0; s < spp; ++s) sum += tracer.radiance(ray, scene.cameraMedium(), rng, start);
+                for (int s = 0; s < spp; ++s) {
+                    const Ray ray = jittered ? scene.camera().generateRay(x + rng.next(), y + rng.next()) : centre;
+                    sum += tracer.radiance(ray, scene.cameraMedium(), rng, start);
+                }
                 image.at(x, y) = sum / float(spp);
             }
         });
@@ -112,7 +116,7 @@ RunStatistics referenceRuns(const Scene& scene, int spp, bool onlyMediumToMedium
 }
 
 RunStatistics vrlRuns(const Scene& scene, const std::string& transports, int spp, uint64_t vrls, int maxDepth = -1,
-                      RenderMethod method = RenderMethod::Vrl) {
+                      RenderMethod method = RenderMethod::Vrl, bool jittered = false) {
     return overRuns([&](uint64_t seed) {
         RenderSettings settings;
         settings.method = method;
@@ -121,6 +125,7 @@ RunStatistics vrlRuns(const Scene& scene, const std::string& transports, int spp
         settings.vrlCount = vrls;
         settings.seed = seed;
         settings.maxDepth = maxDepth;
+        settings.jitter = jittered;
         return render(scene, settings).image;
     });
 }
@@ -188,6 +193,22 @@ TEST(VrlImage, MediumSurfaceEqualsRestrictedReference) {
         expectAgree(vrlRuns(*scene, "medium-surface", 1, kVrls, -1, RenderMethod::VrlLightcuts), reference,
                     (std::string(m.name) + " lightcuts").c_str());
     }
+}
+
+// With jittered rays, (c) is the pixel's mean: its VRLs interleaved over 2 x 2 points
+// of each pixel (interleaved_points.h), plain and by a cut chosen at one of them,
+// against the path tracer restricted as above with jittered rays. The lit room's
+// occluder puts edges inside pixels. Grey medium only, to keep the time down.
+TEST(VrlImage, MediumSurfaceJitteredEqualsRestrictedReference) {
+    const MediumCase& m = kMedia[0];
+    const auto scene = Scene::build(test::litRoomWithOccluder(m.sigmaS * 0.5f, m.sigmaA * 0.5f, m.g));
+    const RunStatistics reference = referenceRuns(*scene, kReferenceSpp, false, -1,
+                                                  PathStart{0, true, false, false, PathStart::AfterFirstSurface::InMedium},
+                                                  true);
+    expectAgree(vrlRuns(*scene, "medium-surface", 1, kVrls, -1, RenderMethod::Vrl, true), reference,
+                "grey, jittered");
+    expectAgree(vrlRuns(*scene, "medium-surface", 1, kVrls, -1, RenderMethod::VrlLightcuts, true), reference,
+                "grey, jittered, lightcuts");
 }
 
 TEST(VrlImage, MediumSurfaceEqualsRestrictedReferenceInSharedVolCbox) {

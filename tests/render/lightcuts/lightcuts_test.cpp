@@ -18,8 +18,10 @@
 namespace vrl {
 namespace {
 
-RenderSettings multipleScattering(RenderMethod method, float error, const char* part = "multiple") {
+RenderSettings multipleScattering(RenderMethod method, float error, const char* part = "multiple",
+                                  bool jitter = false) {
     RenderSettings settings;
+    settings.jitter = jitter;
     settings.method = method;
     settings.transports = TransportSelection::parse(part);
     settings.vrlCount = 6000;
@@ -29,11 +31,11 @@ RenderSettings multipleScattering(RenderMethod method, float error, const char* 
     return settings;
 }
 
-void expectErrorControl(const Scene& scene, const char* name, const char* part = "multiple") {
-    const Image plain = render(scene, multipleScattering(RenderMethod::Vrl, 0.0f, part)).image;
+void expectErrorControl(const Scene& scene, const char* name, const char* part = "multiple", bool jitter = false) {
+    const Image plain = render(scene, multipleScattering(RenderMethod::Vrl, 0.0f, part, jitter)).image;
     double previous = 1e30;
     for (float error : {0.1f, 0.03f, 0.01f}) {
-        const ImageSet cut = render(scene, multipleScattering(RenderMethod::VrlLightcuts, error, part));
+        const ImageSet cut = render(scene, multipleScattering(RenderMethod::VrlLightcuts, error, part, jitter));
         const ImageErrorMetrics m = compareImages(plain, cut.image);
         std::printf("%s %s: threshold %.3f -> relative RMSE %.5f against plain VRLs\n", name, part, error,
                     m.relativeRmse);
@@ -41,7 +43,7 @@ void expectErrorControl(const Scene& scene, const char* name, const char* part =
         EXPECT_LT(m.relativeRmse, previous) << name << " " << part << ": error must shrink with the threshold";
         previous = m.relativeRmse;
     }
-    const ImageSet exact = render(scene, multipleScattering(RenderMethod::VrlLightcuts, 0.0f, part));
+    const ImageSet exact = render(scene, multipleScattering(RenderMethod::VrlLightcuts, 0.0f, part, jitter));
     const double rmse = compareImages(plain, exact.image).relativeRmse;
     std::printf("%s %s: threshold 0 -> relative RMSE %.2e against plain VRLs\n", name, part, rmse);
     EXPECT_LT(rmse, 1e-4) << name << " " << part << ": threshold 0 refines to every VRL";
@@ -71,6 +73,15 @@ TEST(Lightcuts, SurfaceErrorShrinksWithThresholdOnDefaultScene) {
 TEST(Lightcuts, SurfaceErrorShrinksWithThresholdInLitRoom) {
     const auto scene = Scene::build(test::litRoomWithOccluder(Rgb(0.4f), Rgb(0.1f), 0.0f));
     expectErrorControl(*scene, "lit room", "medium-surface");
+}
+
+// Jittered rays: (c) interleaves its VRLs over 2 x 2 points of each pixel
+// (interleaved_points.h), plain and Lightcuts alike (the same points and offset); the
+// cut takes its bounds at one of the points and estimates each node at its
+// representative's point. The occluder puts edges inside pixels.
+TEST(Lightcuts, SurfaceErrorShrinksWithThresholdJitteredInLitRoom) {
+    const auto scene = Scene::build(test::litRoomWithOccluder(Rgb(0.4f), Rgb(0.1f), 0.0f));
+    expectErrorControl(*scene, "lit room, jittered", "medium-surface", true);
 }
 
 // Glossy receivers (a rough-plastic occluder, α 0.1, and a rough-conductor wall panel,

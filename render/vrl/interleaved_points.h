@@ -1,0 +1,57 @@
+// InterleavedPoints: part (c) (VRL-lit surfaces) over several surface points of
+// one pixel for about the price of one.
+//
+// Why: (c) is evaluated once per pixel (transport_integrator.h), at one camera
+// ray jittered over the pixel, while the path-sampled parts average spp rays.
+// Where the pixel holds an edge (a stair's nosing, a railing in front of a wall)
+// the one point lands on either side, and the pixel's (c) jumps between seeds:
+// on staircase at its own resolution that was most of (c)'s remaining noise
+// (one crop held 83% of it; with pixel centres, that crop's variance was 1/6).
+// Evaluating every VRL (or cut) at each of Q points would cost Q times as much.
+//
+// Contract: Q points x_0..x_{Q-1} (one per stratum of the pixel, any of them
+// absent where the camera path has no (c): escaped, an emitter, a depth limit),
+// and an offset o drawn uniformly from {0, ..., Q-1}, independent of the points.
+// Light k (a VRL, by its index; a cut node, by its representative's) is
+// evaluated at x_{(k + o) mod Q} only, an absent point contributing 0:
+//   I = sum_k L_k(x_{(k + o) mod Q}).
+// Derivation (unbiased for the pixel's mean): for each k, (k + o) mod Q is
+// uniform over {0, ..., Q-1} whatever k is, so
+//   E_o[I] = sum_k (1/Q) sum_q L_k(x_q) = (1/Q) sum_q L(x_q),
+// the mean over the Q points of the whole (c), and with stratified points the
+// expectation over their jitter is the pixel's mean (the path tracer's
+// estimand). The variance: each point receives about 1/Q of the lights (one
+// residue class of the index: an even spread, since consecutive VRLs are
+// consecutive pieces of one light path, close in space), so a pixel half on each
+// side of an edge gets half its lights from each side instead of all from one.
+// A cut (surface_vrl_cut.h) picks its nodes with bounds at one of the points (the
+// cut point, chosen without o), then estimates each node at its representative's
+// point: given the cut, the same E_o argument holds node by node. A node and the
+// child that shares its representative are evaluated at the same point, as the
+// walk's inherited estimates require (cut_walk.h).
+// Q = 1 is the single point, bit for bit.
+#pragma once
+
+#include "render/vrl/camera_segment.h"
+
+#include <array>
+#include <cstdint>
+
+namespace vrl {
+
+struct InterleavedPoints {
+    static constexpr uint32_t kMaxPoints = 4;
+    std::array<const CameraPathSurface*, kMaxPoints> points{};  // null: that point has no (c)
+    uint32_t count = 1;   // Q, in [1, kMaxPoints]
+    uint32_t offset = 0;  // o, in [0, count)
+
+    static InterleavedPoints single(const CameraPathSurface& x) {
+        InterleavedPoints p;
+        p.points[0] = &x;
+        return p;
+    }
+    // The point light `index` (a VRL's index in the tree's order) is evaluated at; null: none.
+    const CameraPathSurface* at(uint32_t index) const { return points[(index + offset) % count]; }
+};
+
+}  // namespace vrl

@@ -1,0 +1,143 @@
+// Part (c)'s cut over interleaved points (interleaved_points.h, surface_vrl_cut.h):
+// four points of a diffuse sphere in fog (one of them absent, as where a pixel's
+// stratum sees no surface), 3000 random VRLs in a tree, fixed seeds.
+//  - At threshold 0 the cut reaches every VRL, and VRL k is evaluated at point
+//    (k + o) mod Q from its own stream: the result is that sum computed directly
+//    (float summation order differs: relative 1e-5).
+//  - Summed over the Q offsets, the interleaved results equal the sum over the
+//    points of the whole (c) at each: the identity E_o[I] = (1/Q) sum_q L(x_q)
+//    the estimator's unbiasedness rests on (relative 1e-5, summation order).
+//  - With a threshold, only nodes estimated at the cut point are held against its
+//    bound (boundedEstimates), and a diffuse receiver in an isotropic medium never
+//    exceeds it.
+#include "render/lightcuts/surface_vrl_cut.h"
+
+#include "render/core/rng.h"
+#include "render/lightcuts/light_tree.h"
+#include "render/scene/scene.h"
+#include "render/vrl/vrl_estimator.h"
+#include "tests/support/test_scenes.h"
+
+#include <gtest/gtest.h>
+
+#include <array>
+#include <cmath>
+
+namespace vrl {
+namespace {
+
+constexpr uint64_t kStreamKey = 0x5eed;
+
+struct Fixture {
+    std::unique_ptr<Scene> scene;
+    LightTree tree;
+    std::vector<CameraPathSurface> surfaces;  // the present points
+    InterleavedPoints points;                 // Q = 4; point 1 absent
+};
+
+Fixture sphereInFog() {
+    SceneDescription d = test::pointLightInInfiniteMedium(Rgb(1.0f), Vec3(0.0f, 3.0f, 0.0f), Rgb(0.8f), Rgb(0.2f), 0.0f);
+    d.sensor.toWorld = Transform::lookAt(Vec3(0, 0, -3.5f), Vec3(0, 0, 0), Vec3(0, 1, 0));
+    ShapeDescription sphere;
+    sphere.kind = ShapeDescription::Kind::Sphere;
+    sphere.radius = 1.0f;
+    sphere.bsdf = test::diffuseBsdf(Rgb(0.6f, 0.5f, 0.4f), false);
+    d.shapes.push_back(sphere);
+    Fixture f;
+    f.scene = Scene::build(d);
+    Rng rng(11, 0);
+    std::vector<Vrl> vrls;
+    for (int i = 0; i < 3000; ++i) {
+        Vrl v;
+        v.medium = 0;
+        v.flux = Rgb(0.2f + rng.next(), 0.2f + rng.next(), 0.2f + rng.next()) * 1e-3f;
+        v.origin = Vec3(6 * rng.next() - 3.0f, 6 * rng.next() - 3.0f, 6 * rng.next() - 3.0f);
+        const float z = 2 * rng.next() - 1, phi = 6.2831853f * rng.next(), r = std::sqrt(1 - z * z);
+        v.direction = Vec3(r * std::cos(phi), r * std::sin(phi), z);
+        v.length = 0.1f + 0.5f * rng.next();
+        if ((v.origin + v.direction * v.length).length() < 1.0f || v.origin.length() < 1.0f) continue;
+        vrls.push_back(v);
+    }
+    f.tree = LightTree::build(std::move(vrls), LightTreeSettings{256, 11});
+    // Three points on the sphere's camera side, some way apart (a pixel's strata, enlarged).
+    for (const Vec3& target : {Vec3(-0.3f, 0.2f, -0.9f), Vec3(0.5f, 0.6f, -0.6f), Vec3(0.1f, -0.7f, -0.7f)}) {
+        const Vec3 eye(0.0f, 0.0f, -3.5f);
+        const auto hit = f.scene->intersect(Ray{eye, (target - eye).normalized()});
+        EXPECT_TRUE(hit.has_value());
+        f.surfaces.push_back(cameraPathSurface(*f.scene, *hit, -(target - eye).normalized(), 0, Rgb(1.0f), 0));
+    }
+    f.points.count = 4;
+    f.points.points = {&f.surfaces[0], nullptr, &f.surfaces[1], &f.surfaces[2]};
+    return f;
+}
+
+CutSettings threshold(float error) {
+    CutSettings settings;
+    settings.errorThreshold = error;
+    settings.maxCutSize = 1u << 30;
+    return settings;
+}
+
+// VRL k at `x` from its own stream, as the cut's leaves evaluate it.
+Rgb vrlAt(const VrlSurfaceEstimator& estimator, const LightTree& tree, uint32_t k, const CameraPathSurface& x) {
+    Rng rng = vrlStream(kStreamKey, k);
+    return estimator.contribution(tree.vrls()[k], x, rng);
+}
+
+void expectNear(const Rgb& a, const Rgb& b, double relative, const char* what) {
+    for (int c = 0; c < 3; ++c) EXPECT_NEAR(a[c], b[c], relative * std::abs(b[c]) + 1e-12) << what << " channel " << c;
+}
+
+TEST(SurfaceVrlCut, InterleavedThresholdZeroEvaluatesEachVrlAtItsPoint) {
+    Fixture f = sphereInFog();
+    const VrlSurfaceEstimator estimator(*f.scene, 1);
+    const SurfaceLightcutsEstimator cut(*f.scene, f.tree, estimator, threshold(0.0f));
+    for (uint32_t offset = 0; offset < 4; ++offset) {
+        f.points.offset = offset;
+        Rgb direct(0.0f);
+        for (uint32_t k = 0; k < f.tree.vrls().size(); ++k)
+            if (const CameraPathSurface* x = f.points.at(k)) direct += vrlAt(estimator, f.tree, k, *x);
+        CutStatistics statistics;
+        const Rgb walked = cut.estimate(f.points, f.surfaces[1], kStreamKey, statistics);
+        ASSERT_GT(luminance(direct), 0.0f);
+        expectNear(walked, direct, 1e-5, "threshold 0");
+    }
+}
+
+TEST(SurfaceVrlCut, OffsetsAverageToTheMeanOverThePoints) {
+    Fixture f = sphereInFog();
+    const VrlSurfaceEstimator estimator(*f.scene, 1);
+    const SurfaceLightcutsEstimator cut(*f.scene, f.tree, estimator, threshold(0.0f));
+    Rgb overOffsets(0.0f), overPoints(0.0f);
+    for (uint32_t offset = 0; offset < 4; ++offset) {
+        f.points.offset = offset;
+        CutStatistics statistics;
+        overOffsets += cut.estimate(f.points, f.surfaces[0], kStreamKey, statistics);
+    }
+    for (const CameraPathSurface& x : f.surfaces) {
+        CutStatistics statistics;
+        overPoints += cut.estimate(x, kStreamKey, statistics);
+    }
+    // Both are 4 x the pixel's estimate: sum over o of I_o, and sum over q of L(x_q) (x_1 absent: 0).
+    expectNear(overOffsets, overPoints, 1e-5, "sum over offsets");
+}
+
+TEST(SurfaceVrlCut, OnlyEstimatesAtTheCutPointAreHeldAgainstItsBound) {
+    Fixture f = sphereInFog();
+    const VrlSurfaceEstimator estimator(*f.scene, 1);
+    const SurfaceLightcutsEstimator cut(*f.scene, f.tree, estimator, threshold(0.01f));
+    CutStatistics single, interleaved;
+    cut.estimate(f.surfaces[0], kStreamKey, single);
+    f.points.offset = 2;
+    cut.estimate(f.points, f.surfaces[0], kStreamKey, interleaved);
+    std::printf("bounded estimates: one point %u of %u evaluated, interleaved %u of %u\n", single.boundedEstimates,
+                single.evaluated, interleaved.boundedEstimates, interleaved.evaluated);
+    EXPECT_EQ(single.boundExceeded, 0u);
+    EXPECT_EQ(interleaved.boundExceeded, 0u);
+    ASSERT_GT(interleaved.boundedEstimates, 10u);
+    // About a quarter of the inner nodes are estimated at the cut point (representatives' residues).
+    EXPECT_LT(interleaved.boundedEstimates, interleaved.evaluated / 2);
+}
+
+}  // namespace
+}  // namespace vrl
