@@ -82,6 +82,26 @@ SceneDescription pointLightInInfiniteMedium(const Rgb& intensity, const Vec3& li
     return scene;
 }
 
+SceneDescription sphereInMedium(const Rgb& sigmaS, const Rgb& sigmaA, float g, const BsdfDescription& bsdf,
+                                bool boxed) {
+    SceneDescription d = pointLightInInfiniteMedium(Rgb(1.0f), Vec3(0.0f, 3.0f, 0.0f), sigmaS, sigmaA, g);
+    d.sensor.toWorld = Transform::lookAt(Vec3(0, 0, -3.5f), Vec3(0, 0, 0), Vec3(0, 1, 0));
+    ShapeDescription sphere;
+    sphere.kind = ShapeDescription::Kind::Sphere;
+    sphere.radius = 1.0f;
+    sphere.bsdf = bsdf;
+    d.shapes.push_back(sphere);
+    if (boxed) {
+        ShapeDescription box;
+        box.kind = ShapeDescription::Kind::Cube;
+        box.toWorld = Transform::scale(Vec3(4.0f));
+        box.bsdf = nullBsdf();
+        box.interiorMedium = 0;
+        d.shapes.push_back(box);
+    }
+    return d;
+}
+
 SceneDescription mediumOnlyCube(const Rgb& sigmaS, const Rgb& sigmaA, float g) {
     SceneDescription scene;
     scene.sensor = cameraAtOrigin(16, 16, 40.0f);

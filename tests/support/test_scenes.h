@@ -44,6 +44,13 @@ SceneDescription absorberSlab(const Rgb& radiance, const Rgb& sigmaA, float thic
 SceneDescription pointLightInInfiniteMedium(const Rgb& intensity, const Vec3& lightPosition, const Rgb& sigmaS,
                                            const Rgb& sigmaA, float g);
 
+// A sphere of radius 1 at the origin with `bsdf`, seen from (0, 0, -3.5), lit by a
+// point light at (0, 3, 0), in a medium (sigmaS, sigmaA, HG g) that fills everything
+// or, when `boxed`, the null-bounded cube [-4, 4]^3 (convex). Point queries on the
+// sphere: part (c)'s bounds, cuts and importances.
+SceneDescription sphereInMedium(const Rgb& sigmaS, const Rgb& sigmaA, float g, const BsdfDescription& bsdf,
+                                bool boxed);
+
 // Medium only: a null-bounded cube [-1,1]^3 of medium (sigmaS, sigmaA, HG g)
 // seen from outside (camera in vacuum at z = -3.5), lit by a point light inside it.
 SceneDescription mediumOnlyCube(const Rgb& sigmaS, const Rgb& sigmaA, float g);

@@ -57,20 +57,8 @@ Vec3 randomDirection(Rng& rng) {
 // A diffuse sphere of radius 1 at the origin in a medium filling the null-bounded
 // cube [-4, 4]^3 (convex: the importance's T_r term is exercised).
 std::unique_ptr<Scene> sphereInBoxedMedium(const MediumCase& m) {
-    SceneDescription d = test::pointLightInInfiniteMedium(Rgb(1.0f), Vec3(0.0f, 3.0f, 0.0f), m.sigmaS, m.sigmaA, m.g);
-    d.sensor.toWorld = Transform::lookAt(Vec3(0, 0, -3.5f), Vec3(0, 0, 0), Vec3(0, 1, 0));
-    ShapeDescription sphere;
-    sphere.kind = ShapeDescription::Kind::Sphere;
-    sphere.radius = 1.0f;
-    sphere.bsdf = test::diffuseBsdf(Rgb(0.7f, 0.5f, 0.3f), false);
-    d.shapes.push_back(sphere);
-    ShapeDescription box;
-    box.kind = ShapeDescription::Kind::Cube;
-    box.toWorld = Transform::scale(Vec3(4.0f));
-    box.bsdf = test::nullBsdf();
-    box.interiorMedium = 0;
-    d.shapes.push_back(box);
-    return Scene::build(d);
+    return Scene::build(
+        test::sphereInMedium(m.sigmaS, m.sigmaA, m.g, test::diffuseBsdf(Rgb(0.7f, 0.5f, 0.3f), false), true));
 }
 
 // VRLs in [-3, 3]^3 outside the sphere mostly; every 10th of zero flux, every

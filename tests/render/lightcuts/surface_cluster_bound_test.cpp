@@ -39,25 +39,9 @@ struct Medium {
     float g;
 };
 
-// A sphere of radius 1 at the origin with `bsdf`, in a medium that fills either
-// everything or the null-bounded cube [-4, 4]^3.
+// The sphere in `m` (test::sphereInMedium).
 std::unique_ptr<Scene> sphereInMedium(const Medium& m, const BsdfDescription& bsdf, bool boxed) {
-    SceneDescription d = test::pointLightInInfiniteMedium(Rgb(1.0f), Vec3(0.0f, 3.0f, 0.0f), m.sigmaS, m.sigmaA, m.g);
-    d.sensor.toWorld = Transform::lookAt(Vec3(0, 0, -3.5f), Vec3(0, 0, 0), Vec3(0, 1, 0));
-    ShapeDescription sphere;
-    sphere.kind = ShapeDescription::Kind::Sphere;
-    sphere.radius = 1.0f;
-    sphere.bsdf = bsdf;
-    d.shapes.push_back(sphere);
-    if (boxed) {
-        ShapeDescription box;
-        box.kind = ShapeDescription::Kind::Cube;
-        box.toWorld = Transform::scale(Vec3(4.0f));
-        box.bsdf = test::nullBsdf();
-        box.interiorMedium = 0;
-        d.shapes.push_back(box);
-    }
-    return Scene::build(d);
+    return Scene::build(test::sphereInMedium(m.sigmaS, m.sigmaA, m.g, bsdf, boxed));
 }
 
 Vec3 direction(Rng& rng) {

@@ -36,15 +36,9 @@ struct Fixture {
 };
 
 Fixture sphereInFog() {
-    SceneDescription d = test::pointLightInInfiniteMedium(Rgb(1.0f), Vec3(0.0f, 3.0f, 0.0f), Rgb(0.8f), Rgb(0.2f), 0.0f);
-    d.sensor.toWorld = Transform::lookAt(Vec3(0, 0, -3.5f), Vec3(0, 0, 0), Vec3(0, 1, 0));
-    ShapeDescription sphere;
-    sphere.kind = ShapeDescription::Kind::Sphere;
-    sphere.radius = 1.0f;
-    sphere.bsdf = test::diffuseBsdf(Rgb(0.6f, 0.5f, 0.4f), false);
-    d.shapes.push_back(sphere);
     Fixture f;
-    f.scene = Scene::build(d);
+    f.scene = Scene::build(test::sphereInMedium(Rgb(0.8f), Rgb(0.2f), 0.0f,
+                                                test::diffuseBsdf(Rgb(0.6f, 0.5f, 0.4f), false), false));
     Rng rng(11, 0);
     std::vector<Vrl> vrls;
     for (int i = 0; i < 3000; ++i) {
