@@ -1,8 +1,10 @@
-// PixelFootprint: where a pixel's film square lands on the textures of the surface
-// its once-per-pixel shading point lies on.
+// PixelFootprint: where a film square (a pixel, or the quarter of one that an
+// interleaved point of part (c) stands for) lands on the textures of the surface
+// its shading point lies on.
 //
 // Why: part (c) (VRL-lit surfaces) is evaluated once per pixel, at one camera ray
-// jittered inside the pixel, while the path-sampled parts average the pixel's spp
+// jittered inside the pixel (now at 2 x 2 interleaved points, one per quarter:
+// interleaved_points.h), while the path-sampled parts average the pixel's spp
 // rays. On a textured surface the one point's texel then decides the pixel's value
 // and moves with the jitter: on staircase at its own resolution that was most of
 // (c)'s noise between seeds (crops with the textures made constant lost it).

@@ -8,6 +8,12 @@
 
 namespace vrl {
 
+namespace {
+// Interleaved points on one shape whose geometric normals agree to within about 0.8
+// degrees are one flat piece of surface (interleavedSurface).
+constexpr float kCoherentNormalCosine = 0.9999f;
+}  // namespace
+
 TransportIntegrator::TransportIntegrator(const Scene& scene, const VrlSet& vrls, const TransportIntegratorSettings& settings,
                              const LightTree* tree, const SurfaceVplLights* surfaceVpls)
     : scene_(scene),
@@ -177,7 +183,7 @@ TransportIntegrator::VirtualLightParts TransportIntegrator::virtualLightParts(co
             parts.mediumSurface = interleavedSurface(*pixel, pixelKey, statistics, other);
         } else if (path.surface) {
             if (pixel) averageTextures(*path.surface, *pixel);
-            parts.mediumSurface = vrlLitSurface(InterleavedPoints::single(*path.surface), *path.surface,
+            parts.mediumSurface = vrlLitSurface(InterleavedPoints::single(*path.surface),
                                                 Rng::combine(pixelKey, ~uint64_t(0)), statistics, other);
         }
     }
@@ -227,8 +233,7 @@ Rgb TransportIntegrator::interleavedSurface(const FilmSquare& square, uint64_t p
     const int side = settings_.surfacePointsSide;
     const uint32_t count = uint32_t(side * side);
     if (count > InterleavedPoints::kMaxPoints) throw std::logic_error("interleavedSurface: too many points");
-    // The points' own stream (jitter, specular choices, o and the cut point), apart from
-    // the pixel's other draws.
+    // The points' own stream (jitter, specular choices and o), apart from the pixel's other draws.
     Rng rng = vrlStream(Rng::combine(pixelKey, ~uint64_t(1)), 0);
     std::array<std::optional<CameraPathSurface>, InterleavedPoints::kMaxPoints> surfaces;
     InterleavedPoints points;
@@ -244,26 +249,44 @@ Rgb TransportIntegrator::interleavedSurface(const FilmSquare& square, uint64_t p
         // Past the depth limit the point has no (c) (as vrlLitSurface's single point).
         if (settings_.maxDepth >= 0 && settings_.maxDepth < path.surface->specularBefore + 3) continue;
         surfaces[q] = std::move(path.surface);
-        averageTextures(*surfaces[q], FilmSquare{x0, y0, stratum});
         points.points[q] = &*surfaces[q];
     }
-    // o, then the cut point: the first point present from a start drawn apart from o.
     points.offset = std::min(count - 1, uint32_t(rng.next() * float(count)));
-    const uint32_t start = std::min(count - 1, uint32_t(rng.next() * float(count)));
-    for (uint32_t n = 0; n < count; ++n)
-        if (const CameraPathSurface* cutPoint = points.points[(start + n) % count])
-            return vrlLitSurface(points, *cutPoint, Rng::combine(pixelKey, ~uint64_t(0)), statistics, otherLuminance);
-    return Rgb(0.0f);
+    const uint64_t streamKey = Rng::combine(pixelKey, ~uint64_t(0));
+    // Inside a surface (every point present, seen directly, on one shape, with one
+    // geometric normal) the points differ by little but their texels: one of them, point
+    // o (uniform over the four: the same expectation as the interleaved sum), with its
+    // textures averaged over the whole square, at the cost of one cut. Elsewhere (an
+    // edge, a silhouette, a fold, glass) the VRLs are interleaved over the points, the
+    // cut bounded at all of them.
+    bool coherent = true;
+    for (uint32_t q = 0; q < count && coherent; ++q) {
+        const CameraPathSurface* p = points.points[q];
+        coherent = p && p->specularBefore == 0 && p->hit.shape == points.points[0]->hit.shape &&
+                   p->hit.geometricNormal.dot(points.points[0]->hit.geometricNormal) > kCoherentNormalCosine;
+    }
+    if (coherent) {
+        CameraPathSurface& one = *surfaces[points.offset];
+        averageTextures(one, square);
+        return vrlLitSurface(InterleavedPoints::single(one), streamKey, statistics, otherLuminance);
+    }
+    for (uint32_t q = 0; q < count; ++q)
+        if (surfaces[q])
+            averageTextures(*surfaces[q], FilmSquare{square.x + float(q % uint32_t(side)) * stratum,
+                                                     square.y + float(q / uint32_t(side)) * stratum, stratum});
+    return vrlLitSurface(points, streamKey, statistics, otherLuminance);
 }
 
-Rgb TransportIntegrator::vrlLitSurface(const InterleavedPoints& points, const CameraPathSurface& cutPoint,
-                                       uint64_t streamKey, CutStatistics& statistics, float otherLuminance) const {
-    if (points.count == 1 && settings_.maxDepth >= 0 && settings_.maxDepth < cutPoint.specularBefore + 3)
+Rgb TransportIntegrator::vrlLitSurface(const InterleavedPoints& points, uint64_t streamKey, CutStatistics& statistics,
+                                       float otherLuminance) const {
+    if (points.count == 1 &&
+        (!points.points[0] ||
+         (settings_.maxDepth >= 0 && settings_.maxDepth < points.points[0]->specularBefore + 3)))
         return Rgb(0.0f);
-    if (surfaceLightcuts_) return surfaceLightcuts_->estimate(points, cutPoint, streamKey, statistics, otherLuminance);
-    if (stochastic_) {
+    if (surfaceLightcuts_) return surfaceLightcuts_->estimate(points, streamKey, statistics, otherLuminance);
+    if (stochastic_) {  // one point: per camera sample
         Rng rng = vrlStream(streamKey, ~0u);
-        return stochastic_->estimate(cutPoint, rng, statistics);
+        return stochastic_->estimate(*points.points[0], rng, statistics);
     }
     Rgb sum(0.0f);
     const auto& vrls = tree_ ? tree_->vrls() : vrls_.vrls;

@@ -34,7 +34,8 @@
 //       (VrlSurfaceEstimator), a cut through the VRL tree (surface_vrl_cut.h)
 //       or a stochastic cut (stochastic_vrl_cut.h) at x1; once per pixel with
 //       jittered rays, the VRLs are interleaved over 2 x 2 points x1 of the
-//       pixel instead (interleaved_points.h); the VPL methods path-trace it
+//       pixel instead (interleaved_points.h; vrl-stochastic, per camera
+//       sample, keeps the sample's own x1); the VPL methods path-trace it
 //       (their lights are points);
 //   (d) x1 and x2 in media: every VRL (--method vrl), a cut (vrl-lightcuts) or
 //       a stochastic cut (vrl-stochastic) against each camera segment, or VPLs
@@ -143,9 +144,9 @@ private:
     Rgb mediumToSurface(const CameraSegment& segment, Rng& rng) const;
     // Part (a)'s light from the surface VPLs at this camera sample's x1.
     Rgb surfaceVplsAtSurface(const Ray& cameraRay, Rng& rng) const;
-    // (c) over `points`, the cut (if any) chosen at `cutPoint`, one of them.
-    Rgb vrlLitSurface(const InterleavedPoints& points, const CameraPathSurface& cutPoint, uint64_t streamKey,
-                      CutStatistics& statistics, float otherLuminance) const;
+    // (c) over `points` (a cut takes its bounds at one of them: SurfaceLightcutsEstimator::cutPoint).
+    Rgb vrlLitSurface(const InterleavedPoints& points, uint64_t streamKey, CutStatistics& statistics,
+                      float otherLuminance) const;
     // (c) over surfacePointsSide^2 stratified points of `square`, from streams keyed by pixelKey.
     Rgb interleavedSurface(const FilmSquare& square, uint64_t pixelKey, CutStatistics& statistics,
                            float otherLuminance) const;

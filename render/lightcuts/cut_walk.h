@@ -8,10 +8,6 @@
 //   Rgb  leaf(int32_t node)                       exact estimate of a leaf
 //   bool bound(int32_t node, Rgb& bound)          false: the query crosses the node
 //   Rgb  estimate(int32_t node)                   the node's representative estimate
-// and optionally
-//   bool estimatedAtBoundPoint(int32_t node)      false: the estimate is made at another
-//                                                 point than the bound (interleaved_points.h),
-//                                                 so it is not counted against it
 //
 // Contract the walk relies on (true of every visitor in render/lightcuts/): a
 // node's estimate is its representative's estimate with the representative's
@@ -167,14 +163,6 @@ Rgb walkCut(const LightTree& tree, const CutSettings& settings, CutStatistics& s
         __builtin_prefetch(first + sizeof(LightTreeNode) - 1);
     };
     const auto exceeds = [](const Rgb& e, const Rgb& b) { return e.x > b.x || e.y > b.y || e.z > b.z; };
-    // Whether a node's estimate is made where its bound is taken (an interleaved visitor's
-    // is not always): only those count in boundedEstimates and boundExceeded.
-    const auto heldAgainstBound = [&](int32_t i) {
-        if constexpr (requires { { visitor.estimatedAtBoundPoint(i) } -> std::convertible_to<bool>; })
-            return bool(visitor.estimatedAtBoundPoint(i));
-        else
-            return true;
-    };
     const auto heapKey = [](const Rgb& b) {
         const float key = luminance(b);
         return key >= 0.0f ? key : std::numeric_limits<float>::infinity();  // NaN: refine
@@ -187,9 +175,8 @@ Rgb walkCut(const LightTree& tree, const CutSettings& settings, CutStatistics& s
             ++leavesInCut;
             return;
         }
-        const bool held = heldAgainstBound(i);
-        if (held) ++statistics.boundedEstimates;
-        const bool exceeded = held && exceeds(e, b);
+        ++statistics.boundedEstimates;
+        const bool exceeded = exceeds(e, b);
         if (exceeded) ++statistics.boundExceeded;
         typename Scratch::CutNode entry{heapKey(b), i, e, d};
         if constexpr (kDeferred) entry.state.exceeded = exceeded;
@@ -261,9 +248,7 @@ Rgb walkCut(const LightTree& tree, const CutSettings& settings, CutStatistics& s
         const float threshold = settings.errorThreshold * (std::max(0.0f, luminance(total)) + otherLuminance);
         for (int refined = 0; refined < kRefineBatch && !heap.empty();) {
             typename Scratch::CutNode top = heap.front();
-            // Threshold 0 is the exact sum: every node is refined, one whose bound is 0
-            // too (an interleaved visitor's bound holds at one point only).
-            if (top.bound <= threshold && settings.errorThreshold > 0.0f) break;
+            if (top.bound <= threshold) break;
             // The cut's size after `refined` refinements of this batch (each adds one node).
             if (heap.size() + leavesInCut + 2 * size_t(refined) >= settings.maxCutSize) break;
             std::pop_heap(heap.begin(), heap.end());
@@ -273,7 +258,7 @@ Rgb walkCut(const LightTree& tree, const CutSettings& settings, CutStatistics& s
                     Rgb b(0.0f);
                     visitor.tighten(top.node, b, top.state.factor);
                     top.state.tight = true;
-                    const bool nowExceeded = heldAgainstBound(top.node) && exceeds(top.estimate, b);
+                    const bool nowExceeded = exceeds(top.estimate, b);
                     if (nowExceeded != top.state.exceeded) {  // count the node against the bound it now has
                         if (nowExceeded) ++statistics.boundExceeded;
                         else --statistics.boundExceeded;

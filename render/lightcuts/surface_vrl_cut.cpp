@@ -3,7 +3,9 @@
 #include "render/lightcuts/cut_walk.h"
 #include "render/lightcuts/vrl_cut.h"
 
+#include <algorithm>
 #include <array>
+#include <limits>
 
 namespace vrl {
 
@@ -18,12 +20,30 @@ SurfaceLightcutsEstimator::SurfaceLightcutsEstimator(const Scene& scene, const L
 
 Rgb SurfaceLightcutsEstimator::estimate(const CameraPathSurface& x, uint64_t streamKey, CutStatistics& statistics,
                                         float otherLuminance) const {
-    return estimate(InterleavedPoints::single(x), x, streamKey, statistics, otherLuminance);
+    return estimate(InterleavedPoints::single(x), streamKey, statistics, otherLuminance);
 }
 
-Rgb SurfaceLightcutsEstimator::estimate(const InterleavedPoints& points, const CameraPathSurface& x,
-                                        uint64_t streamKey, CutStatistics& statistics, float otherLuminance) const {
+const CameraPathSurface* SurfaceLightcutsEstimator::cutPoint(const InterleavedPoints& points) const {
+    const CameraPathSurface* best = nullptr;
+    float most = -1.0f;
+    for (uint32_t q = 0; q < points.count; ++q) {
+        const CameraPathSurface* p = points.points[q];
+        if (!p) continue;
+        if (points.count == 1 || tree_.empty()) return p;
+        bool inside = false;
+        const float root = luminance(bound_.bound(tree_.root(), *p, &inside));
+        const float key = inside || !(root >= 0.0f) ? std::numeric_limits<float>::infinity() : root;
+        if (key > most) best = p, most = key;
+    }
+    return best;
+}
+
+Rgb SurfaceLightcutsEstimator::estimate(const InterleavedPoints& points, uint64_t streamKey, CutStatistics& statistics,
+                                        float otherLuminance) const {
     if (tree_.empty()) return Rgb(0.0f);
+    const CameraPathSurface* cut = cutPoint(points);
+    if (!cut) return Rgb(0.0f);
+    const CameraPathSurface& x = *cut;
     struct Visitor {
         const SurfaceLightcutsEstimator& self;
         const InterleavedPoints& points;
@@ -49,6 +69,27 @@ Rgb SurfaceLightcutsEstimator::estimate(const InterleavedPoints& points, const C
         mutable std::array<double, kDistanceSlots> distance{};
         bool bound(int32_t i, const Rgb* inherited, Rgb& b, Rgb& factor, bool& tight) const {
             bool inside = false;
+            if (points.count > 1) {
+                // Interleaved: the node's VRLs go to any of the points, so its bound is the
+                // largest of its bounds at them (each is Phi_C times the most a unit of flux
+                // anywhere in the box gives that point, so the maximum bounds the node's light
+                // wherever each VRL goes). The query crosses the node where the cut point lies
+                // in its box; a box that holds another point is refined (infinite bound).
+                b = self.bound_.bound(i, x, &inside);
+                for (uint32_t q = 0; q < points.count && !inside; ++q) {
+                    const CameraPathSurface* p = points.points[q];
+                    if (!p || p == &x) continue;
+                    bool within = false;
+                    const Rgb at = self.bound_.bound(i, *p, &within);
+                    if (within) {
+                        b = Rgb(std::numeric_limits<float>::infinity());
+                        break;
+                    }
+                    b = Rgb(std::max(b.x, at.x), std::max(b.y, at.y), std::max(b.z, at.z));
+                }
+                tight = true;
+                return !inside;
+            }
             double d = 0.0;
             b = self.bound_.cheapBound(i, x, &inside, inherited, &factor, &tight, &d);
             if (!tight) distanceNode[size_t(i) % kDistanceSlots] = i, distance[size_t(i) % kDistanceSlots] = d;
@@ -61,10 +102,6 @@ Rgb SurfaceLightcutsEstimator::estimate(const InterleavedPoints& points, const C
         Rgb estimate(int32_t i) const {
             const LightTreeNode& node = self.tree_.nodes()[i];
             return at(node.representative, node.clusterFlux);
-        }
-        // Only an estimate made where the bound was taken can be held against it.
-        bool estimatedAtBoundPoint(int32_t i) const {
-            return points.count == 1 || points.at(self.tree_.nodes()[i].representative) == &x;
         }
     };
     Visitor visitor{*this, points, x, streamKey, {}, {}};

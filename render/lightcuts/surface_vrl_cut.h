@@ -7,8 +7,8 @@
 // small share of a surface pixel, and the paper's error is relative to the
 // pixel). A node whose box holds x has no bound and is
 // refined without being estimated (#Inter); leaves are single VRLs.
-// Over interleaved points (interleaved_points.h) the bounds are taken at the cut
-// point and each node is estimated at its representative's point.
+// Over interleaved points (interleaved_points.h) each node is estimated at its
+// representative's point and bounded by the largest of its bounds at the points.
 #pragma once
 
 #include "render/lightcuts/cut_settings.h"
@@ -34,11 +34,15 @@ public:
     // the pixel's other parts (cut_walk.h).
     Rgb estimate(const CameraPathSurface& x, uint64_t streamKey, CutStatistics& statistics,
                  float otherLuminance = 0.0f) const;
-    // The same over interleaved points: the cut chosen with bounds at `cutPoint` (one of
-    // `points`), node n estimated at points.at(its representative). boundExceeded and
-    // boundedEstimates count only the nodes estimated at the cut point.
-    Rgb estimate(const InterleavedPoints& points, const CameraPathSurface& cutPoint, uint64_t streamKey,
-                 CutStatistics& statistics, float otherLuminance = 0.0f) const;
+    // The same over interleaved points: node n estimated at points.at(its representative)
+    // and bounded by the largest of its bounds at the points present, so every estimate is
+    // held against a bound that holds where it is made. The query crosses a node where
+    // cutPoint(points) lies in its box.
+    Rgb estimate(const InterleavedPoints& points, uint64_t streamKey, CutStatistics& statistics,
+                 float otherLuminance = 0.0f) const;
+    // The point the crossing test is made at: the present point with the largest bound of
+    // the root; null when none is present. Depends on the points, not on o.
+    const CameraPathSurface* cutPoint(const InterleavedPoints& points) const;
 
 private:
     const LightTree& tree_;

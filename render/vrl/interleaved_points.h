@@ -24,11 +24,21 @@
 // residue class of the index: an even spread, since consecutive VRLs are
 // consecutive pieces of one light path, close in space), so a pixel half on each
 // side of an edge gets half its lights from each side instead of all from one.
-// A cut (surface_vrl_cut.h) picks its nodes with bounds at one of the points (the
-// cut point, chosen without o), then estimates each node at its representative's
-// point: given the cut, the same E_o argument holds node by node. A node and the
-// child that shares its representative are evaluated at the same point, as the
-// walk's inherited estimates require (cut_walk.h).
+// Exactly so for the plain sum and for a cut at threshold 0 (every VRL reached).
+// A cut (surface_vrl_cut.h) estimates each node at its representative's point; a
+// node and the child that shares its representative are then evaluated at the same
+// point, as the walk's inherited estimates require (cut_walk.h). Its bound is the
+// largest of its bounds at the points: each is Phi_C times the most a unit of flux
+// anywhere in the box gives that point, so the maximum bounds
+// sum_{k in C} L_k(x_{(k + o) mod Q}) wherever each VRL goes, and the cut keeps its
+// proven error control. That costs Q bounds per node (staircase's render took 1.8
+// times as long with every pixel interleaved), so the integrator interleaves only
+// where the points differ (transport_integrator.cpp: an edge, a silhouette, a fold,
+// glass); inside one flat piece of one shape it takes the single point x_o, whose
+// expectation over o is the same mean, at the price of one cut. With a threshold the
+// cut depends on o (through the running total), and the image carries the cut's
+// approximation as any Lightcuts image does, measured against the plain
+// interleaved sum (Lightcuts.SurfaceErrorShrinksWithThresholdJitteredInLitRoom).
 // Q = 1 is the single point, bit for bit.
 #pragma once
 

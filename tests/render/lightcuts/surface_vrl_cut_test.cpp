@@ -7,9 +7,16 @@
 //  - Summed over the Q offsets, the interleaved results equal the sum over the
 //    points of the whole (c) at each: the identity E_o[I] = (1/Q) sum_q L(x_q)
 //    the estimator's unbiasedness rests on (relative 1e-5, summation order).
-//  - With a threshold, only nodes estimated at the cut point are held against its
-//    bound (boundedEstimates), and a diffuse receiver in an isotropic medium never
-//    exceeds it.
+//  - With a threshold, a node's bound is the largest of its bounds at the points,
+//    so every estimate is held against a bound that holds where it is made and, a
+//    diffuse receiver in an isotropic medium, never exceeds it; the pixel's value
+//    stays within 3 thresholds (0.03) of the plain interleaved sum for every
+//    offset (each node's error is within one). The points are far apart (normals
+//    60-70 degrees apart): with the cut point's bound alone the error was 13-72%.
+//  - A point whose bound is 0 for every node (its camera path's throughput is 0)
+//    is not taken as the cut point, and at threshold 0.01 the result stays within
+//    5% of the plain interleaved sum (with that point's bound alone it was off by
+//    99%: the cut stopped almost at once).
 #include "render/lightcuts/surface_vrl_cut.h"
 
 #include "render/core/rng.h"
@@ -57,11 +64,14 @@ Fixture sphereInFog() {
     for (const Vec3& target : {Vec3(-0.3f, 0.2f, -0.9f), Vec3(0.5f, 0.6f, -0.6f), Vec3(0.1f, -0.7f, -0.7f)}) {
         const Vec3 eye(0.0f, 0.0f, -3.5f);
         const auto hit = f.scene->intersect(Ray{eye, (target - eye).normalized()});
-        EXPECT_TRUE(hit.has_value());
+        if (!hit) {
+            ADD_FAILURE() << "the fixture's ray misses the sphere";
+            continue;
+        }
         f.surfaces.push_back(cameraPathSurface(*f.scene, *hit, -(target - eye).normalized(), 0, Rgb(1.0f), 0));
     }
     f.points.count = 4;
-    f.points.points = {&f.surfaces[0], nullptr, &f.surfaces[1], &f.surfaces[2]};
+    if (f.surfaces.size() == 3) f.points.points = {&f.surfaces[0], nullptr, &f.surfaces[1], &f.surfaces[2]};
     return f;
 }
 
@@ -84,6 +94,7 @@ void expectNear(const Rgb& a, const Rgb& b, double relative, const char* what) {
 
 TEST(SurfaceVrlCut, InterleavedThresholdZeroEvaluatesEachVrlAtItsPoint) {
     Fixture f = sphereInFog();
+    ASSERT_EQ(f.surfaces.size(), 3u);
     const VrlSurfaceEstimator estimator(*f.scene, 1);
     const SurfaceLightcutsEstimator cut(*f.scene, f.tree, estimator, threshold(0.0f));
     for (uint32_t offset = 0; offset < 4; ++offset) {
@@ -92,7 +103,7 @@ TEST(SurfaceVrlCut, InterleavedThresholdZeroEvaluatesEachVrlAtItsPoint) {
         for (uint32_t k = 0; k < f.tree.vrls().size(); ++k)
             if (const CameraPathSurface* x = f.points.at(k)) direct += vrlAt(estimator, f.tree, k, *x);
         CutStatistics statistics;
-        const Rgb walked = cut.estimate(f.points, f.surfaces[1], kStreamKey, statistics);
+        const Rgb walked = cut.estimate(f.points, kStreamKey, statistics);
         ASSERT_GT(luminance(direct), 0.0f);
         expectNear(walked, direct, 1e-5, "threshold 0");
     }
@@ -100,13 +111,14 @@ TEST(SurfaceVrlCut, InterleavedThresholdZeroEvaluatesEachVrlAtItsPoint) {
 
 TEST(SurfaceVrlCut, OffsetsAverageToTheMeanOverThePoints) {
     Fixture f = sphereInFog();
+    ASSERT_EQ(f.surfaces.size(), 3u);
     const VrlSurfaceEstimator estimator(*f.scene, 1);
     const SurfaceLightcutsEstimator cut(*f.scene, f.tree, estimator, threshold(0.0f));
     Rgb overOffsets(0.0f), overPoints(0.0f);
     for (uint32_t offset = 0; offset < 4; ++offset) {
         f.points.offset = offset;
         CutStatistics statistics;
-        overOffsets += cut.estimate(f.points, f.surfaces[0], kStreamKey, statistics);
+        overOffsets += cut.estimate(f.points, kStreamKey, statistics);
     }
     for (const CameraPathSurface& x : f.surfaces) {
         CutStatistics statistics;
@@ -116,21 +128,49 @@ TEST(SurfaceVrlCut, OffsetsAverageToTheMeanOverThePoints) {
     expectNear(overOffsets, overPoints, 1e-5, "sum over offsets");
 }
 
-TEST(SurfaceVrlCut, OnlyEstimatesAtTheCutPointAreHeldAgainstItsBound) {
+TEST(SurfaceVrlCut, EveryEstimateStaysWithinTheBoundOverThePoints) {
     Fixture f = sphereInFog();
+    ASSERT_EQ(f.surfaces.size(), 3u);
     const VrlSurfaceEstimator estimator(*f.scene, 1);
     const SurfaceLightcutsEstimator cut(*f.scene, f.tree, estimator, threshold(0.01f));
-    CutStatistics single, interleaved;
-    cut.estimate(f.surfaces[0], kStreamKey, single);
-    f.points.offset = 2;
-    cut.estimate(f.points, f.surfaces[0], kStreamKey, interleaved);
-    std::printf("bounded estimates: one point %u of %u evaluated, interleaved %u of %u\n", single.boundedEstimates,
-                single.evaluated, interleaved.boundedEstimates, interleaved.evaluated);
-    EXPECT_EQ(single.boundExceeded, 0u);
-    EXPECT_EQ(interleaved.boundExceeded, 0u);
-    ASSERT_GT(interleaved.boundedEstimates, 10u);
-    // About a quarter of the inner nodes are estimated at the cut point (representatives' residues).
-    EXPECT_LT(interleaved.boundedEstimates, interleaved.evaluated / 2);
+    for (uint32_t offset = 0; offset < 4; ++offset) {
+        f.points.offset = offset;
+        Rgb plain(0.0f);
+        for (uint32_t k = 0; k < f.tree.vrls().size(); ++k)
+            if (const CameraPathSurface* x = f.points.at(k)) plain += vrlAt(estimator, f.tree, k, *x);
+        CutStatistics statistics;
+        const Rgb walked = cut.estimate(f.points, kStreamKey, statistics);
+        const double error = std::abs(double(luminance(walked)) - luminance(plain)) / luminance(plain);
+        std::printf("offset %u: %u of %u estimates bounded, relative error %.4f against the plain interleaved sum\n",
+                    offset, statistics.boundedEstimates, statistics.evaluated, error);
+        EXPECT_EQ(statistics.boundExceeded, 0u) << "offset " << offset;
+        EXPECT_GT(statistics.boundedEstimates, 10u);
+        // Each node's error is within the threshold of the total; a cut's errors add up,
+        // partly cancelling: within 3 thresholds (measured 0.3-1.9%).
+        EXPECT_LT(error, 0.03) << "offset " << offset;
+    }
+}
+
+TEST(SurfaceVrlCut, ACutPointThatSeesNothingDoesNotStopTheCut) {
+    Fixture f = sphereInFog();
+    ASSERT_EQ(f.surfaces.size(), 3u);
+    CameraPathSurface blind = f.surfaces[0];
+    blind.throughput = Rgb(0.0f);  // every bound at it is 0
+    f.points.points[1] = &blind;   // present, but contributes nothing
+    f.points.offset = 3;
+    const VrlSurfaceEstimator estimator(*f.scene, 1);
+    Rgb plain(0.0f);
+    for (uint32_t k = 0; k < f.tree.vrls().size(); ++k)
+        if (const CameraPathSurface* x = f.points.at(k)) plain += vrlAt(estimator, f.tree, k, *x);
+    const SurfaceLightcutsEstimator cut(*f.scene, f.tree, estimator, threshold(0.01f));
+    CutStatistics statistics;
+    EXPECT_NE(cut.cutPoint(f.points), &blind);
+    const Rgb walked = cut.estimate(f.points, kStreamKey, statistics);
+    const double error = std::abs(double(luminance(walked)) - luminance(plain)) / luminance(plain);
+    std::printf("cut point blind: cut size %u, relative error %.4f against the plain interleaved sum (%g, %g)\n",
+                statistics.cutSize, error, double(luminance(walked)), double(luminance(plain)));
+    EXPECT_GT(statistics.cutSize, 10u);
+    EXPECT_LT(error, 0.05);
 }
 
 }  // namespace
