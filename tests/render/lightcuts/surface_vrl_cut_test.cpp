@@ -88,25 +88,16 @@ Rgb vrlAt(const VrlSurfaceEstimator& estimator, const LightTree& tree, uint32_t 
     return estimator.contribution(tree.vrls()[k], x, rng);
 }
 
-void expectNear(const Rgb& a, const Rgb& b, double relative, const char* what) {
-    for (int c = 0; c < 3; ++c) EXPECT_NEAR(a[c], b[c], relative * std::abs(b[c]) + 1e-12) << what << " channel " << c;
+// The plain interleaved sum: every VRL at its point, from its own stream.
+Rgb plainInterleaved(const Fixture& f, const VrlSurfaceEstimator& estimator) {
+    Rgb sum(0.0f);
+    for (uint32_t k = 0; k < f.tree.vrls().size(); ++k)
+        if (const CameraPathSurface* x = f.points.at(k)) sum += vrlAt(estimator, f.tree, k, *x);
+    return sum;
 }
 
-TEST(SurfaceVrlCut, InterleavedThresholdZeroEvaluatesEachVrlAtItsPoint) {
-    Fixture f = sphereInFog();
-    ASSERT_EQ(f.surfaces.size(), 3u);
-    const VrlSurfaceEstimator estimator(*f.scene, 1);
-    const SurfaceLightcutsEstimator cut(*f.scene, f.tree, estimator, threshold(0.0f));
-    for (uint32_t offset = 0; offset < 4; ++offset) {
-        f.points.offset = offset;
-        Rgb direct(0.0f);
-        for (uint32_t k = 0; k < f.tree.vrls().size(); ++k)
-            if (const CameraPathSurface* x = f.points.at(k)) direct += vrlAt(estimator, f.tree, k, *x);
-        CutStatistics statistics;
-        const Rgb walked = cut.estimate(f.points, kStreamKey, statistics);
-        ASSERT_GT(luminance(direct), 0.0f);
-        expectNear(walked, direct, 1e-5, "threshold 0");
-    }
+void expectNear(const Rgb& a, const Rgb& b, double relative, const char* what) {
+    for (int c = 0; c < 3; ++c) EXPECT_NEAR(a[c], b[c], relative * std::abs(b[c]) + 1e-12) << what << " channel " << c;
 }
 
 TEST(SurfaceVrlCut, OffsetsAverageToTheMeanOverThePoints) {
@@ -128,16 +119,18 @@ TEST(SurfaceVrlCut, OffsetsAverageToTheMeanOverThePoints) {
     expectNear(overOffsets, overPoints, 1e-5, "sum over offsets");
 }
 
-TEST(SurfaceVrlCut, EveryEstimateStaysWithinTheBoundOverThePoints) {
+TEST(SurfaceVrlCut, CutAgainstThePlainInterleavedSum) {
     Fixture f = sphereInFog();
     ASSERT_EQ(f.surfaces.size(), 3u);
     const VrlSurfaceEstimator estimator(*f.scene, 1);
+    const SurfaceLightcutsEstimator exact(*f.scene, f.tree, estimator, threshold(0.0f));
     const SurfaceLightcutsEstimator cut(*f.scene, f.tree, estimator, threshold(0.01f));
     for (uint32_t offset = 0; offset < 4; ++offset) {
         f.points.offset = offset;
-        Rgb plain(0.0f);
-        for (uint32_t k = 0; k < f.tree.vrls().size(); ++k)
-            if (const CameraPathSurface* x = f.points.at(k)) plain += vrlAt(estimator, f.tree, k, *x);
+        const Rgb plain = plainInterleaved(f, estimator);
+        ASSERT_GT(luminance(plain), 0.0f);
+        CutStatistics exactStatistics;
+        expectNear(exact.estimate(f.points, kStreamKey, exactStatistics), plain, 1e-5, "threshold 0");
         CutStatistics statistics;
         const Rgb walked = cut.estimate(f.points, kStreamKey, statistics);
         const double error = std::abs(double(luminance(walked)) - luminance(plain)) / luminance(plain);
@@ -159,9 +152,7 @@ TEST(SurfaceVrlCut, ACutPointThatSeesNothingDoesNotStopTheCut) {
     f.points.points[1] = &blind;   // present, but contributes nothing
     f.points.offset = 3;
     const VrlSurfaceEstimator estimator(*f.scene, 1);
-    Rgb plain(0.0f);
-    for (uint32_t k = 0; k < f.tree.vrls().size(); ++k)
-        if (const CameraPathSurface* x = f.points.at(k)) plain += vrlAt(estimator, f.tree, k, *x);
+    const Rgb plain = plainInterleaved(f, estimator);
     const SurfaceLightcutsEstimator cut(*f.scene, f.tree, estimator, threshold(0.01f));
     CutStatistics statistics;
     EXPECT_NE(cut.cutPoint(f.points), &blind);
