@@ -47,7 +47,7 @@ Rgb SurfaceLightcutsEstimator::estimate(const InterleavedPoints& points, uint64_
     struct Visitor {
         const SurfaceLightcutsEstimator& self;
         const InterleavedPoints& points;
-        const CameraPathSurface& x;  // the cut point: every bound is taken here
+        const CameraPathSurface& x;  // the cut point: the crossing test (and, one point, every bound) is made here
         uint64_t streamKey;
         // VRL k (with `flux`) at its interleaved point, from its own stream.
         Rgb at(uint32_t k, const Rgb& flux) const {
