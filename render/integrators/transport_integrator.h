@@ -87,8 +87,6 @@ struct TransportIntegratorSettings {
     int surfacePointsSide = 1;
 };
 
-// Part (c)'s interleaved points per side of a pixel (or of a shading point's stratum).
-inline constexpr int kInterleavedPointsSide = 2;
 
 class TransportIntegrator {
 public:

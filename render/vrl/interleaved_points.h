@@ -49,8 +49,11 @@
 
 namespace vrl {
 
+// Part (c)'s interleaved points per side of a pixel (or of a shading point's stratum).
+inline constexpr int kInterleavedPointsSide = 2;
+
 struct InterleavedPoints {
-    static constexpr uint32_t kMaxPoints = 4;
+    static constexpr uint32_t kMaxPoints = uint32_t(kInterleavedPointsSide * kInterleavedPointsSide);
     std::array<const CameraPathSurface*, kMaxPoints> points{};  // null: that point has no (c)
     uint32_t count = 1;   // Q, in [1, kMaxPoints]
     uint32_t offset = 0;  // o, in [0, count)
