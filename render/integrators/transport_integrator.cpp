@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <optional>
+#include <span>
 #include <stdexcept>
 
 namespace vrl {
@@ -182,7 +183,7 @@ TransportIntegrator::VirtualLightParts TransportIntegrator::virtualLightParts(co
         if (pixel && settings_.surfacePointsSide > 1 && !stochastic_) {
             parts.mediumSurface = interleavedSurface(*pixel, pixelKey, statistics, other);
         } else if (path.surface) {
-            if (pixel) averageTextures(*path.surface, *pixel);
+            if (pixel) averageTextures(*path.surface, std::span<const FilmSquare>(pixel, 1));
             parts.mediumSurface = vrlLitSurface(InterleavedPoints::single(*path.surface),
                                                 Rng::combine(pixelKey, ~uint64_t(0)), statistics, other);
         }
@@ -223,9 +224,18 @@ Rgb TransportIntegrator::surfaceVplsAtSurface(const Ray& cameraRay, Rng& rng) co
     return surfaceVplLightcuts_->sample(*path.surface, surfaceVplRadius_, kSurfaceVplSamples, rng, unused);
 }
 
-void TransportIntegrator::averageTextures(CameraPathSurface& x, const FilmSquare& square) const {
+void TransportIntegrator::averageTextures(CameraPathSurface& x, std::span<const FilmSquare> squares) const {
     if (x.specularBefore != 0 || !scene_.shapes()[x.hit.shape].bsdf.isTextured()) return;
-    if (const auto uvs = footprintTexcoords(scene_, square, x.hit)) x.bsdf.averageTexturesOver(*uvs);
+    std::array<Vec2, size_t(kFootprintPoints) * InterleavedPoints::kMaxPoints> uvs;
+    size_t count = 0;
+    for (const FilmSquare& square : squares) {
+        if (count + kFootprintPoints > uvs.size()) break;
+        if (const auto footprint = footprintTexcoords(scene_, square, x.hit)) {
+            std::copy(footprint->begin(), footprint->end(), uvs.begin() + std::ptrdiff_t(count));
+            count += kFootprintPoints;
+        }
+    }
+    x.bsdf.averageTexturesOver(std::span<const Vec2>(uvs.data(), count));
 }
 
 Rgb TransportIntegrator::interleavedSurface(const FilmSquare& square, uint64_t pixelKey, CutStatistics& statistics,
@@ -233,47 +243,75 @@ Rgb TransportIntegrator::interleavedSurface(const FilmSquare& square, uint64_t p
     const int side = settings_.surfacePointsSide;
     const uint32_t count = uint32_t(side * side);
     if (count > InterleavedPoints::kMaxPoints) throw std::logic_error("interleavedSurface: too many points");
-    // The points' own stream (jitter, specular choices and o), apart from the pixel's other draws.
+    // The points' own stream (jitter, specular choices, o and the representatives), apart
+    // from the pixel's other draws.
     Rng rng = vrlStream(Rng::combine(pixelKey, ~uint64_t(1)), 0);
     std::array<std::optional<CameraPathSurface>, InterleavedPoints::kMaxPoints> surfaces;
-    InterleavedPoints points;
-    points.count = count;
+    std::array<FilmSquare, InterleavedPoints::kMaxPoints> strata;
     const float stratum = square.size / float(side);
     for (uint32_t q = 0; q < count; ++q) {
-        const float x0 = square.x + float(q % uint32_t(side)) * stratum;
-        const float y0 = square.y + float(q / uint32_t(side)) * stratum;
+        strata[q] = FilmSquare{square.x + float(q % uint32_t(side)) * stratum,
+                               square.y + float(q / uint32_t(side)) * stratum, stratum};
         const float jx = rng.next(), jy = rng.next();
-        const Ray ray = scene_.camera().generateRay(x0 + jx * stratum, y0 + jy * stratum);
+        const Ray ray = scene_.camera().generateRay(strata[q].x + jx * stratum, strata[q].y + jy * stratum);
         CameraPath path = cameraPath(scene_, ray, scene_.cameraMedium(), &rng, settings_.maxDepth);
         if (!path.surface) continue;
         // Past the depth limit the point has no (c) (as vrlLitSurface's single point).
         if (settings_.maxDepth >= 0 && settings_.maxDepth < path.surface->specularBefore + 3) continue;
         surfaces[q] = std::move(path.surface);
-        points.points[q] = &*surfaces[q];
     }
-    points.offset = std::min(count - 1, uint32_t(rng.next() * float(count)));
+    const uint32_t offset = std::min(count - 1, uint32_t(rng.next() * float(count)));
     const uint64_t streamKey = Rng::combine(pixelKey, ~uint64_t(0));
-    // Inside a surface (every point present, seen directly, on one shape, with one
-    // geometric normal) the points differ by little but their texels: one of them, point
-    // o (uniform over the four: the same expectation as the interleaved sum), with its
-    // textures averaged over the whole square, at the cost of one cut. Elsewhere (an
-    // edge, a silhouette, a fold, glass) the VRLs are interleaved over the points, the
-    // cut bounded at all of them.
-    bool coherent = true;
-    for (uint32_t q = 0; q < count && coherent; ++q) {
-        const CameraPathSurface* p = points.points[q];
-        coherent = p && p->specularBefore == 0 && p->hit.shape == points.points[0]->hit.shape &&
-                   p->hit.geometricNormal.dot(points.points[0]->hit.geometricNormal) > kCoherentNormalCosine;
+    // Classes of coherent points (interleaved_points.h): a point seen directly joins the
+    // first class whose first point lies on the same shape with the same geometric normal
+    // (one flat piece of surface, where the points differ by little but their texels);
+    // any other present point (through glass, a mirror) is a class of its own.
+    std::array<int32_t, InterleavedPoints::kMaxPoints> classOf;
+    std::array<uint32_t, InterleavedPoints::kMaxPoints> firstOf{}, sizeOf{};
+    classOf.fill(-1);
+    uint32_t classes = 0;
+    for (uint32_t q = 0; q < count; ++q) {
+        if (!surfaces[q]) continue;
+        const CameraPathSurface& p = *surfaces[q];
+        int32_t c = -1;
+        for (uint32_t j = 0; j < classes && c < 0 && p.specularBefore == 0; ++j) {
+            const CameraPathSurface& f = *surfaces[firstOf[j]];
+            if (f.specularBefore == 0 && f.hit.shape == p.hit.shape &&
+                f.hit.geometricNormal.dot(p.hit.geometricNormal) > kCoherentNormalCosine)
+                c = int32_t(j);
+        }
+        if (c < 0) c = int32_t(classes), firstOf[classes++] = q;
+        classOf[q] = c;
+        ++sizeOf[uint32_t(c)];
     }
-    if (coherent) {
-        CameraPathSurface& one = *surfaces[points.offset];
-        averageTextures(one, square);
+    if (classes == 1 && sizeOf[0] == count) {
+        // Inside a surface: point o (uniform over the four), with its textures averaged
+        // over the whole square, at the cost of one cut.
+        CameraPathSurface& one = *surfaces[offset];
+        averageTextures(one, std::span<const FilmSquare>(&square, 1));
         return vrlLitSurface(InterleavedPoints::single(one), streamKey, statistics, otherLuminance);
     }
+    // Elsewhere (an edge, a silhouette, a fold, glass, a point that escapes) each class
+    // is represented by one of its points, drawn uniformly, with its textures averaged
+    // over its class's strata; VRL k goes to the representative of point (k + o) mod Q's
+    // class, the cut bounded at the representatives (as many bounds per node as classes).
+    InterleavedPoints points;
+    points.count = count;
+    points.offset = offset;
+    std::array<CameraPathSurface*, InterleavedPoints::kMaxPoints> representative{};
+    for (uint32_t c = 0; c < classes; ++c) {
+        const uint32_t pick = std::min(sizeOf[c] - 1, uint32_t(rng.next() * float(sizeOf[c])));
+        std::array<FilmSquare, InterleavedPoints::kMaxPoints> squares;
+        uint32_t members = 0;
+        for (uint32_t q = 0; q < count; ++q) {
+            if (classOf[q] != int32_t(c)) continue;
+            if (members == pick) representative[c] = &*surfaces[q];
+            squares[members++] = strata[q];
+        }
+        averageTextures(*representative[c], std::span<const FilmSquare>(squares.data(), members));
+    }
     for (uint32_t q = 0; q < count; ++q)
-        if (surfaces[q])
-            averageTextures(*surfaces[q], FilmSquare{square.x + float(q % uint32_t(side)) * stratum,
-                                                     square.y + float(q / uint32_t(side)) * stratum, stratum});
+        points.points[q] = classOf[q] >= 0 ? representative[uint32_t(classOf[q])] : nullptr;
     return vrlLitSurface(points, streamKey, statistics, otherLuminance);
 }
 

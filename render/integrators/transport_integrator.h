@@ -64,6 +64,7 @@
 
 #include <array>
 #include <memory>
+#include <span>
 
 namespace vrl {
 
@@ -112,8 +113,9 @@ public:
     };
     // `pixel`: the film square the call stands for, when it is evaluated once for it
     // (once per pixel, or per shading point): (c) then interleaves its VRLs over
-    // settings.surfacePointsSide^2 points of the square (interleaved_points.h), each
-    // with its textures' mean over its stratum (pixel_footprint.h), or with one point
+    // settings.surfacePointsSide^2 points of the square (interleaved_points.h), one
+    // representative per class of coherent points, with its textures' mean over its
+    // class's strata (pixel_footprint.h), or with one point
     // (side 1), the ray's own, its textures averaged over the square. Null: the ray's
     // own point and lookups.
     VirtualLightParts virtualLightParts(const Ray& cameraRay, Rng& rng, CutStatistics* multipleStatistics = nullptr,
@@ -148,8 +150,9 @@ private:
     // (c) over surfacePointsSide^2 stratified points of `square`, from streams keyed by pixelKey.
     Rgb interleavedSurface(const FilmSquare& square, uint64_t pixelKey, CutStatistics& statistics,
                            float otherLuminance) const;
-    // The point's BSDF takes its textures' mean over `square` (a point the camera sees directly).
-    void averageTextures(CameraPathSurface& x, const FilmSquare& square) const;
+    // The point's BSDF takes its textures' mean over `squares` (a point the camera sees
+    // directly; squares whose rays miss its plane are left out).
+    void averageTextures(CameraPathSurface& x, std::span<const FilmSquare> squares) const;
 
     const Scene& scene_;
     const VrlSet& vrls_;

@@ -31,10 +31,21 @@
 // largest of its bounds at the points: each is Phi_C times the most a unit of flux
 // anywhere in the box gives that point, so the maximum bounds
 // sum_{k in C} L_k(x_{(k + o) mod Q}) wherever each VRL goes, and the cut keeps its
-// proven error control. That costs Q bounds per node (staircase's render took 1.8
-// times as long with every pixel interleaved), so the integrator interleaves only
-// where the points differ (transport_integrator.cpp: an edge, a silhouette, a fold,
-// glass); inside one flat piece of one shape it takes the single point x_o, whose
+// proven error control. That costs one bound per node and point (staircase's render
+// took 1.8 times as long with every pixel interleaved over four), and where points
+// lie on one flat piece of one shape they differ by little but their texels. So the
+// integrator (transport_integrator.cpp) groups the points into classes of such
+// points and lets one point of each class, drawn uniformly from it independently of
+// o, stand for the whole class: entry q of `points` then holds the representative
+// r(c(q)) of q's class, the same pointer at several entries (a representative takes
+// its textures' mean over its class's strata: pixel_footprint.h). Unbiased still: for
+// each k, q = (k + o) mod Q is uniform, so the class c is drawn with probability
+// n_c / Q, and the representative is uniform within it,
+//   E[L_k(r(c(q)))] = sum_c (n_c / Q) (1 / n_c) sum_{q' in c} L_k(x_q') = (1/Q) sum_q L_k(x_q).
+// The cut then bounds each node at the representatives only (distinct()): an edge
+// between two surfaces pays two bounds, not four, and one class (with points
+// absent) pays the one point's own bound, which holds for any subset of the VRLs.
+// Where all Q points are one class the integrator takes point x_o alone, whose
 // expectation over o is the same mean, at the price of one cut. With a threshold the
 // cut depends on o (through the running total), and the image carries the cut's
 // approximation as any Lightcuts image does, measured against the plain
@@ -65,6 +76,19 @@ struct InterleavedPoints {
     }
     // The point light `index` (a VRL's index in the tree's order) is evaluated at; null: none.
     const CameraPathSurface* at(uint32_t index) const { return points[(index + offset) % count]; }
+    // The different points present (several entries may hold one point: a class's
+    // representative), in order of first appearance; returns how many.
+    uint32_t distinct(std::array<const CameraPathSurface*, kMaxPoints>& out) const {
+        uint32_t n = 0;
+        for (uint32_t q = 0; q < count; ++q) {
+            const CameraPathSurface* p = points[q];
+            if (!p) continue;
+            bool seen = false;
+            for (uint32_t j = 0; j < n && !seen; ++j) seen = out[j] == p;
+            if (!seen) out[n++] = p;
+        }
+        return n;
+    }
 };
 
 }  // namespace vrl
