@@ -34,6 +34,7 @@
 
 #include <array>
 #include <cmath>
+#include <string>
 
 namespace vrl {
 namespace {
@@ -104,23 +105,34 @@ void expectNear(const Rgb& a, const Rgb& b, double relative, const char* what) {
     for (int c = 0; c < 3; ++c) EXPECT_NEAR(a[c], b[c], relative * std::abs(b[c]) + 1e-12) << what << " channel " << c;
 }
 
+// The cut's results summed over the Q offsets of `points`.
+Rgb sumOverOffsets(const SurfaceLightcutsEstimator& cut, InterleavedPoints points) {
+    Rgb sum(0.0f);
+    for (uint32_t offset = 0; offset < points.count; ++offset) {
+        points.offset = offset;
+        CutStatistics statistics;
+        sum += cut.estimate(points, kStreamKey, statistics);
+    }
+    return sum;
+}
+
+// The whole (c) at each present point, summed.
+Rgb sumOverPoints(const SurfaceLightcutsEstimator& cut, const Fixture& f) {
+    Rgb sum(0.0f);
+    for (const CameraPathSurface& x : f.surfaces) {
+        CutStatistics statistics;
+        sum += cut.estimate(x, kStreamKey, statistics);
+    }
+    return sum;
+}
+
 TEST(SurfaceVrlCut, OffsetsAverageToTheMeanOverThePoints) {
     Fixture f = sphereInFog();
     ASSERT_EQ(f.surfaces.size(), 3u);
     const VrlSurfaceEstimator estimator(*f.scene, 1);
     const SurfaceLightcutsEstimator cut(*f.scene, f.tree, estimator, threshold(0.0f));
-    Rgb overOffsets(0.0f), overPoints(0.0f);
-    for (uint32_t offset = 0; offset < 4; ++offset) {
-        f.points.offset = offset;
-        CutStatistics statistics;
-        overOffsets += cut.estimate(f.points, kStreamKey, statistics);
-    }
-    for (const CameraPathSurface& x : f.surfaces) {
-        CutStatistics statistics;
-        overPoints += cut.estimate(x, kStreamKey, statistics);
-    }
     // Both are 4 x the pixel's estimate: sum over o of I_o, and sum over q of L(x_q) (x_1 absent: 0).
-    expectNear(overOffsets, overPoints, 1e-5, "sum over offsets");
+    expectNear(sumOverOffsets(cut, f.points), sumOverPoints(cut, f), 1e-5, "sum over offsets");
 }
 
 TEST(SurfaceVrlCut, RepresentativesAverageToTheMeanOverThePoints) {
@@ -132,28 +144,18 @@ TEST(SurfaceVrlCut, RepresentativesAverageToTheMeanOverThePoints) {
     ASSERT_EQ(f.surfaces.size(), 3u);
     const VrlSurfaceEstimator estimator(*f.scene, 1);
     const SurfaceLightcutsEstimator cut(*f.scene, f.tree, estimator, threshold(0.0f));
-    Rgb overChoices(0.0f), overPoints(0.0f);
+    Rgb overChoices(0.0f);
     for (const CameraPathSurface* representative : {&f.surfaces[0], &f.surfaces[1]}) {
         f.points.points = {representative, nullptr, representative, &f.surfaces[2]};
-        for (uint32_t offset = 0; offset < 4; ++offset) {
-            f.points.offset = offset;
-            CutStatistics statistics;
-            overChoices += cut.estimate(f.points, kStreamKey, statistics);
-        }
+        overChoices += sumOverOffsets(cut, f.points);
     }
-    for (const CameraPathSurface& x : f.surfaces) {
-        CutStatistics statistics;
-        overPoints += cut.estimate(x, kStreamKey, statistics);
-    }
-    expectNear(overChoices, overPoints * 2.0f, 1e-5, "sum over representatives and offsets");
+    expectNear(overChoices, sumOverPoints(cut, f) * 2.0f, 1e-5, "sum over representatives and offsets");
 }
 
-TEST(SurfaceVrlCut, CutAgainstThePlainInterleavedSum) {
-    Fixture f = sphereInFog();
-    ASSERT_EQ(f.surfaces.size(), 3u);
-    const VrlSurfaceEstimator estimator(*f.scene, 1);
-    const SurfaceLightcutsEstimator exact(*f.scene, f.tree, estimator, threshold(0.0f));
-    const SurfaceLightcutsEstimator cut(*f.scene, f.tree, estimator, threshold(0.01f));
+// For every offset of f.points: threshold 0 (`exact`) gives the plain interleaved sum;
+// `cut` (threshold 0.01) exceeds no bound and stays within `tolerance` of that sum.
+void expectCutHolds(Fixture& f, const VrlSurfaceEstimator& estimator, const SurfaceLightcutsEstimator& exact,
+                    const SurfaceLightcutsEstimator& cut, const std::string& label, double tolerance) {
     for (uint32_t offset = 0; offset < 4; ++offset) {
         f.points.offset = offset;
         const Rgb plain = plainInterleaved(f, estimator);
@@ -163,14 +165,24 @@ TEST(SurfaceVrlCut, CutAgainstThePlainInterleavedSum) {
         CutStatistics statistics;
         const Rgb walked = cut.estimate(f.points, kStreamKey, statistics);
         const double error = std::abs(double(luminance(walked)) - luminance(plain)) / luminance(plain);
-        std::printf("offset %u: %u of %u estimates bounded, relative error %.4f against the plain interleaved sum\n",
-                    offset, statistics.boundedEstimates, statistics.evaluated, error);
-        EXPECT_EQ(statistics.boundExceeded, 0u) << "offset " << offset;
+        std::printf("%s, offset %u: cut size %u, %u of %u estimates bounded, relative error %.4f against the plain "
+                    "interleaved sum\n",
+                    label.c_str(), offset, statistics.cutSize, statistics.boundedEstimates, statistics.evaluated, error);
+        EXPECT_EQ(statistics.boundExceeded, 0u) << label << ", offset " << offset;
         EXPECT_GT(statistics.boundedEstimates, 10u);
-        // Each node's error is within the threshold of the total; a cut's errors add up,
-        // partly cancelling: within 3 thresholds (measured 0.3-1.9%).
-        EXPECT_LT(error, 0.03) << "offset " << offset;
+        EXPECT_LT(error, tolerance) << label << ", offset " << offset;
     }
+}
+
+TEST(SurfaceVrlCut, CutAgainstThePlainInterleavedSum) {
+    Fixture f = sphereInFog();
+    ASSERT_EQ(f.surfaces.size(), 3u);
+    const VrlSurfaceEstimator estimator(*f.scene, 1);
+    const SurfaceLightcutsEstimator exact(*f.scene, f.tree, estimator, threshold(0.0f));
+    const SurfaceLightcutsEstimator cut(*f.scene, f.tree, estimator, threshold(0.01f));
+    // Each node's error is within the threshold of the total; a cut's errors add up,
+    // partly cancelling: within 3 thresholds (measured 0.3-1.9%).
+    expectCutHolds(f, estimator, exact, cut, "three points", 0.03);
 }
 
 TEST(SurfaceVrlCut, RepresentativesAreBoundedOncePerClass) {
@@ -201,22 +213,9 @@ TEST(SurfaceVrlCut, RepresentativesAreBoundedOncePerClass) {
             f.points.points = layout;
             std::array<const CameraPathSurface*, InterleavedPoints::kMaxPoints> distinct{};
             EXPECT_EQ(f.points.distinct(distinct), layout[3] ? 2u : 1u);
-            for (uint32_t offset = 0; offset < 4; ++offset) {
-                f.points.offset = offset;
-                const Rgb plain = plainInterleaved(f, estimator);
-                ASSERT_GT(luminance(plain), 0.0f);
-                CutStatistics exactStatistics;
-                expectNear(exact.estimate(f.points, kStreamKey, exactStatistics), plain, 1e-5, "threshold 0");
-                CutStatistics statistics;
-                const Rgb walked = cut.estimate(f.points, kStreamKey, statistics);
-                const double error = std::abs(double(luminance(walked)) - luminance(plain)) / luminance(plain);
-                std::printf("%s, %s, offset %u: cut size %u, relative error %.4f against the plain interleaved sum\n",
-                            isGlossy ? "glossy" : "diffuse", layout[3] ? "two classes" : "one class", offset,
-                            statistics.cutSize, error);
-                EXPECT_EQ(statistics.boundExceeded, 0u) << "offset " << offset;
-                EXPECT_GT(statistics.boundedEstimates, 10u);
-                EXPECT_LT(error, 0.05) << "offset " << offset;
-            }
+            expectCutHolds(f, estimator, exact, cut,
+                           std::string(isGlossy ? "glossy" : "diffuse") + (layout[3] ? ", two classes" : ", one class"),
+                           0.05);
         }
     }
 }
