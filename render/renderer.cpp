@@ -476,8 +476,9 @@ TileSums TileShader::shadeTile(const TileRect& tile, int firstPass, int passCoun
                     Rng rng(settings_.seed, Rng::combine(pixel, kPixelLightsSample - uint64_t(m)));
                     const Ray ray = stratifiedCameraRay(camera, settings_, x, y, m % side, m / side, side, rng);
                     // The point's stratum: (c) interleaves its VRLs over 2 x 2 points of it when
-                    // jittered, each with its textures averaged over its quarter, else takes the
-                    // ray's own point with its textures averaged over the stratum (pixel_footprint.h).
+                    // jittered, one representative per class of coherent points, with its
+                    // textures averaged over its class's quarters, else takes the ray's own point
+                    // with its textures averaged over the stratum (pixel_footprint.h).
                     const float stratum = 1.0f / float(side);
                     const FilmSquare square{float(x + camera.cropX0()) + float(m % side) * stratum,
                                             float(y + camera.cropY0()) + float(m / side) * stratum, stratum};

@@ -1,6 +1,6 @@
-// PixelFootprint: where a film square (a pixel, or the quarter of one that an
-// interleaved point of part (c) stands for) lands on the textures of the surface
-// its shading point lies on.
+// PixelFootprint: where a film square (a pixel, or a quarter of one that an
+// interleaved point of part (c) stands for: interleaved_points.h) lands on the
+// textures of the surface its shading point lies on.
 //
 // Why: part (c) (VRL-lit surfaces) is evaluated once per pixel, at one camera ray
 // jittered inside the pixel (now at 2 x 2 interleaved points, one per quarter:

@@ -11,8 +11,18 @@ namespace vrl {
 
 namespace {
 // Interleaved points on one shape whose geometric normals agree to within about 0.8
-// degrees are one flat piece of surface (interleavedSurface).
+// degrees, and whose offset lies in that plane to within about 0.06 degrees (not two
+// parallel faces of one mesh, such as two treads of a staircase), are one flat piece
+// of surface (interleavedSurface).
 constexpr float kCoherentNormalCosine = 0.9999f;
+constexpr float kCoplanarSine = 1e-3f;
+
+bool onePiece(const CameraPathSurface& a, const CameraPathSurface& b) {
+    if (a.specularBefore != 0 || b.specularBefore != 0 || a.hit.shape != b.hit.shape) return false;
+    if (!(a.hit.geometricNormal.dot(b.hit.geometricNormal) > kCoherentNormalCosine)) return false;
+    const Vec3 offset = b.hit.position - a.hit.position;
+    return std::abs(a.hit.geometricNormal.dot(offset)) <= kCoplanarSine * offset.length();
+}
 }  // namespace
 
 TransportIntegrator::TransportIntegrator(const Scene& scene, const VrlSet& vrls, const TransportIntegratorSettings& settings,
@@ -263,9 +273,10 @@ Rgb TransportIntegrator::interleavedSurface(const FilmSquare& square, uint64_t p
     const uint32_t offset = std::min(count - 1, uint32_t(rng.next() * float(count)));
     const uint64_t streamKey = Rng::combine(pixelKey, ~uint64_t(0));
     // Classes of coherent points (interleaved_points.h): a point seen directly joins the
-    // first class whose first point lies on the same shape with the same geometric normal
-    // (one flat piece of surface, where the points differ by little but their texels);
-    // any other present point (through glass, a mirror) is a class of its own.
+    // first class whose first point lies on the same shape, with the same geometric
+    // normal, in the same plane (one flat piece of surface, where the points differ by
+    // little but their texels); any other present point (through glass, a mirror) is a
+    // class of its own.
     std::array<int32_t, InterleavedPoints::kMaxPoints> classOf;
     std::array<uint32_t, InterleavedPoints::kMaxPoints> firstOf{}, sizeOf{};
     classOf.fill(-1);
@@ -274,12 +285,8 @@ Rgb TransportIntegrator::interleavedSurface(const FilmSquare& square, uint64_t p
         if (!surfaces[q]) continue;
         const CameraPathSurface& p = *surfaces[q];
         int32_t c = -1;
-        for (uint32_t j = 0; j < classes && c < 0 && p.specularBefore == 0; ++j) {
-            const CameraPathSurface& f = *surfaces[firstOf[j]];
-            if (f.specularBefore == 0 && f.hit.shape == p.hit.shape &&
-                f.hit.geometricNormal.dot(p.hit.geometricNormal) > kCoherentNormalCosine)
-                c = int32_t(j);
-        }
+        for (uint32_t j = 0; j < classes && c < 0; ++j)
+            if (onePiece(*surfaces[firstOf[j]], p)) c = int32_t(j);
         if (c < 0) c = int32_t(classes), firstOf[classes++] = q;
         classOf[q] = c;
         ++sizeOf[uint32_t(c)];

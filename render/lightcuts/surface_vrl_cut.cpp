@@ -102,7 +102,9 @@ Rgb SurfaceLightcutsEstimator::estimate(const InterleavedPoints& points, uint64_
                 const Rgb at = self.bound_.cheapBound(i, point(j), &inside, inherited, &f, &pointTight, &d);
                 if (inside) {
                     if (j == 0) return false;  // crossed at x
-                    // Another point in the box: refine; its children start from no factor.
+                    // Another point in the box: refine. Its children inherit an infinite
+                    // factor: at a glossy point their cheap bound is infinite, and made
+                    // tight before they are refined.
                     b = factor = Rgb(std::numeric_limits<float>::infinity());
                     tight = true;
                     return true;

@@ -42,6 +42,11 @@
 // each k, q = (k + o) mod Q is uniform, so the class c is drawn with probability
 // n_c / Q, and the representative is uniform within it,
 //   E[L_k(r(c(q)))] = sum_c (n_c / Q) (1 / n_c) sum_{q' in c} L_k(x_q') = (1/Q) sum_q L_k(x_q).
+// (Exactly so without textures. With them, the representative's lookups are its
+// class's mean, so the expectation takes each point's light with its class's mean
+// texture: the approximation pixel_footprint.h makes for the whole pixel, over a
+// class's quarters instead of one quarter; they differ by the covariance of light
+// and texture inside the class.)
 // The cut then bounds each node at the representatives only (distinct()): an edge
 // between two surfaces pays two bounds, not four, and one class (with points
 // absent) pays the one point's own bound, which holds for any subset of the VRLs.

@@ -76,9 +76,9 @@ TEST(Lightcuts, SurfaceErrorShrinksWithThresholdInLitRoom) {
 }
 
 // Jittered rays: (c) interleaves its VRLs over 2 x 2 points of each pixel
-// (interleaved_points.h), plain and Lightcuts alike (the same points and offset); the
-// cut takes its bounds at one of the points and estimates each node at its
-// representative's point. The occluder puts edges inside pixels.
+// (interleaved_points.h), plain and Lightcuts alike (the same points, classes and
+// offset); the cut bounds each node at every point a VRL goes to and estimates it at
+// its representative's point. The occluder puts edges inside pixels.
 TEST(Lightcuts, SurfaceErrorShrinksWithThresholdJitteredInLitRoom) {
     const auto scene = Scene::build(test::litRoomWithOccluder(Rgb(0.4f), Rgb(0.1f), 0.0f));
     expectErrorControl(*scene, "lit room, jittered", "medium-surface", true);
