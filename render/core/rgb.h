@@ -15,6 +15,10 @@ using Rgb = Imath::V3f;
 inline float luminance(const Rgb& c) { return 0.212671f * c.x + 0.715160f * c.y + 0.072169f * c.z; }
 inline float maxComponent(const Rgb& c) { return std::max({c.x, c.y, c.z}); }
 inline float minComponent(const Rgb& c) { return std::min({c.x, c.y, c.z}); }
+// The channel-wise maximum of a and b.
+inline Rgb componentMax(const Rgb& a, const Rgb& b) {
+    return Rgb(std::max(a.x, b.x), std::max(a.y, b.y), std::max(a.z, b.z));
+}
 inline float average(const Rgb& c) { return (c.x + c.y + c.z) / 3.0f; }
 inline bool isBlack(const Rgb& c) { return c.x == 0.0f && c.y == 0.0f && c.z == 0.0f; }
 inline bool isFinite(const Rgb& c) { return std::isfinite(c.x) && std::isfinite(c.y) && std::isfinite(c.z); }

@@ -34,7 +34,7 @@ Rgb surfaceVplReflectionBound(const Scene& scene, const SurfaceVpl& vpl) {
     Rgb largest(0.0f);
     for (const Vec3& w : {mirror, n, -mirror, -n}) {
         const Rgb f = bsdf.eval(hit.shadingPoint(), wo, w, TransportMode::Importance);
-        largest = Rgb(std::max(largest.x, f.x), std::max(largest.y, f.y), std::max(largest.z, f.z));
+        largest = componentMax(largest, f);
     }
     return largest * 2.0f;
 }

@@ -17,6 +17,7 @@
 #include "render/vrl/interleaved_points.h"
 #include "render/vrl/vrl_surface_estimator.h"
 
+#include <array>
 #include <cstdint>
 
 namespace vrl {
@@ -45,6 +46,10 @@ public:
     const CameraPathSurface* cutPoint(const InterleavedPoints& points) const;
 
 private:
+    // cutPoint among the n different points of `distinct` (InterleavedPoints::distinct): its index.
+    uint32_t cutPointAmong(const std::array<const CameraPathSurface*, InterleavedPoints::kMaxPoints>& distinct,
+                           uint32_t n) const;
+
     const LightTree& tree_;
     const VrlSurfaceEstimator& estimator_;
     CutSettings settings_;
