@@ -12,6 +12,7 @@
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
 
 #include <algorithm>
 #include <atomic>
@@ -266,6 +267,14 @@ std::vector<TileRect> imageTiles(int width, int height, int tileSize) {
         for (int x0 = 0; x0 < width; x0 += tile)
             tiles.push_back({x0, y0, std::min(width, x0 + tile), std::min(height, y0 + tile)});
     return tiles;
+}
+
+int balancedTileSize(int width, int height, int tileSize, int threads) {
+    int tile = std::max(1, tileSize);
+    const auto count = [&](int side) { return int64_t((width + side - 1) / side) * ((height + side - 1) / side); };
+    const int64_t wanted = int64_t(kTilesPerThread) * std::max(1, threads);
+    while (tile / 2 >= kMinBalancedTileSize && count(tile) < wanted) tile /= 2;
+    return tile;
 }
 
 std::vector<std::string> renderLayerNames(const RenderSettings& settings) {
@@ -631,7 +640,8 @@ ImageSet render(const Scene& scene, const RenderSettings& settings, const Progre
     const auto start = std::chrono::steady_clock::now();
     const TileShader shader(scene, settings, lights);
     const int width = scene.camera().width(), height = scene.camera().height();
-    const std::vector<TileRect> tiles = imageTiles(width, height, settings.tileSize);
+    const std::vector<TileRect> tiles = imageTiles(
+        width, height, balancedTileSize(width, height, settings.tileSize, tbb::this_task_arena::max_concurrency()));
     const int cap = settings.samplesPerPixel;
     SampleSums sums;
     std::vector<int> tileRows(tiles.size(), 0);

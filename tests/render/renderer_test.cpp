@@ -126,6 +126,24 @@ TEST(RendererDeterminism, JitteredImagesIgnoreThreadsAndTileSize) {
     }
 }
 
+// The embedded render's tiles: halved until each thread has kTilesPerThread of them, never
+// below kMinBalancedTileSize, never above the requested side.
+TEST(RendererTiles, BalancedTileSizeGivesEveryThreadEnoughTiles) {
+    EXPECT_EQ(balancedTileSize(45, 80, 32, 2), 8);     // 6 tiles of 32, 15 of 16, 60 of 8
+    EXPECT_EQ(balancedTileSize(320, 240, 32, 2), 32);  // 80 tiles already
+    EXPECT_EQ(balancedTileSize(320, 240, 32, 8), 16);  // 80 < 128: 300 of 16
+    EXPECT_EQ(balancedTileSize(8, 8, 32, 16), kMinBalancedTileSize);
+    EXPECT_EQ(balancedTileSize(1280, 720, 16, 1), 16);  // never larger than asked
+    EXPECT_EQ(balancedTileSize(10, 10, 3, 8), 3);       // nor halved below the minimum
+    for (const int threads : {1, 2, 3, 8, 64})
+        for (const int width : {1, 7, 45, 320, 1280}) {
+            const int side = balancedTileSize(width, 80, 32, threads);
+            const int64_t tiles = int64_t(imageTiles(width, 80, side).size());
+            EXPECT_TRUE(tiles >= int64_t(kTilesPerThread) * threads || side / 2 < kMinBalancedTileSize)
+                << width << "x80, " << threads << " threads: " << tiles << " tiles of " << side;
+        }
+}
+
 // A crop window (hdrfilm cropOffsetX..., --crop) renders the window of the full
 // film bit for bit: every layer, with jitter on and off, for path and vrl-lightcuts.
 const Image& layer(const ImageSet& set, const std::string& name) {
