@@ -204,8 +204,13 @@ Rgb SurfaceClusterBound::boundAt(int32_t index, const CameraPathSurface& x, doub
     Rgb between(1.0f);
     if (vrlMedium && node.medium == x.medium && reflectsOnly && !shape.changesMedium && vrlMedium->boundaryConvex())
         between = vrlMedium->transmittance(float(d));
-    const double scale = kRoundingMargin * phase / (d * d);
-    return node.fluxLength * sigmaS * fCos * between * x.throughput * float(scale);
+    // Phi_C (theta_B - theta_A) / h <= Phi_C min(L_rep / d^2, pi / d) (header), per channel.
+    const double inverse = 1.0 / d;
+    const auto along = [&](int c) {
+        return float(std::min(double(node.fluxLength[c]) * inverse, M_PI * double(node.clusterFlux[c])) * inverse);
+    };
+    const Rgb overDistance(along(0), along(1), along(2));
+    return overDistance * sigmaS * fCos * between * x.throughput * float(kRoundingMargin * phase);
 }
 
 }  // namespace vrl

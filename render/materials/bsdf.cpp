@@ -528,6 +528,16 @@ double microfacetMaximum(MicrofacetKind kind, double alphaU, double alphaV, doub
     return norm * best;
 }
 
+// Whether microfacetMaximum over [0, thetaHigh] is D's value at theta = 0 whatever
+// thetaHigh: GGX with a^2 < 1 decreases in theta; Beckmann's g decreases for t >= 0
+// when its peak t* = 2 a^2 - 1 is <= 0.
+bool microfacetPeaksAtNormal(MicrofacetKind kind, double alphaU, double alphaV) {
+    const double au = std::clamp(alphaU, double(MicrofacetDistribution::kMinAlpha), double(MicrofacetDistribution::kMaxAlpha));
+    const double av = std::clamp(alphaV, double(MicrofacetDistribution::kMinAlpha), double(MicrofacetDistribution::kMaxAlpha));
+    const double a2 = std::max(au, av) * std::max(au, av);
+    return kind == MicrofacetKind::GGX ? a2 < 1.0 : 2.0 * a2 - 1.0 <= 0.0;
+}
+
 }  // namespace
 
 std::optional<Rgb> PreparedBsdf::coneBound(const Vec3& axis, double halfAngle) const {
@@ -562,7 +572,10 @@ std::optional<Rgb> PreparedBsdf::coneBound(const Vec3& axis, double halfAngle) c
         const double lipschitz = 1.0 / (2.0 * std::cos(0.5 * gammaMax));
         const V3d r(-wo.x, -wo.y, wo.z);
         const bool holdsMirror = r.dot(c) >= std::cos(beta);
-        if (beta * lipschitz < 1e-3) {  // a small cone: about its centre's half vector
+        if (holdsMirror && microfacetPeaksAtNormal(bsdf_->distribution_, bsdf_->alphaU_, bsdf_->alphaV_)) {
+            // D's largest value is at theta_h = 0, in the cap: the circle's extremes do
+            // not change it (thetaLow = 0 below, thetaHigh stays pi/2).
+        } else if (beta * lipschitz < 1e-3) {  // a small cone: about its centre's half vector
             const double thetaH = std::acos(std::clamp((wo + c).normalized().z, -1.0, 1.0));
             thetaLow = std::max(0.0, thetaH - beta * lipschitz - 1e-6);
             thetaHigh = std::min(0.5 * kPiD, thetaH + beta * lipschitz + 1e-6);
