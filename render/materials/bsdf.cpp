@@ -504,12 +504,21 @@ constexpr double kPiD = std::numbers::pi;
 // A bound: empty where it is not finite (never black in its place).
 std::optional<Rgb> finiteBound(const Rgb& b) { return isFinite(b) ? std::optional<Rgb>(b) : std::nullopt; }
 
+// The roughnesses as the distribution clamps them, and the isotropic majorant's a^2.
+struct ClampedAlphas {
+    double u, v, a2;
+};
+ClampedAlphas clampedAlphas(double alphaU, double alphaV) {
+    const double au = std::clamp(alphaU, double(MicrofacetDistribution::kMinAlpha), double(MicrofacetDistribution::kMaxAlpha));
+    const double av = std::clamp(alphaV, double(MicrofacetDistribution::kMinAlpha), double(MicrofacetDistribution::kMaxAlpha));
+    return {au, av, std::max(au, av) * std::max(au, av)};
+}
+
 // The largest D over normals whose angle to n lies in [thetaLow, thetaHigh] (within
 // [0, pi/2]), from the isotropic majorant of bsdf.h's derivation.
 double microfacetMaximum(MicrofacetKind kind, double alphaU, double alphaV, double thetaLow, double thetaHigh) {
-    const double au = std::clamp(alphaU, double(MicrofacetDistribution::kMinAlpha), double(MicrofacetDistribution::kMaxAlpha));
-    const double av = std::clamp(alphaV, double(MicrofacetDistribution::kMinAlpha), double(MicrofacetDistribution::kMaxAlpha));
-    const double a2 = std::max(au, av) * std::max(au, av), norm = 1.0 / (kPiD * au * av);
+    const auto [au, av, a2] = clampedAlphas(alphaU, alphaV);
+    const double norm = 1.0 / (kPiD * au * av);
     if (kind == MicrofacetKind::GGX) {
         const auto at = [&](double theta) {
             const double s = std::sin(theta), c = std::cos(theta);
@@ -532,9 +541,7 @@ double microfacetMaximum(MicrofacetKind kind, double alphaU, double alphaV, doub
 // thetaHigh: GGX with a^2 < 1 decreases in theta; Beckmann's g decreases for t >= 0
 // when its peak t* = 2 a^2 - 1 is <= 0.
 bool microfacetPeaksAtNormal(MicrofacetKind kind, double alphaU, double alphaV) {
-    const double au = std::clamp(alphaU, double(MicrofacetDistribution::kMinAlpha), double(MicrofacetDistribution::kMaxAlpha));
-    const double av = std::clamp(alphaV, double(MicrofacetDistribution::kMinAlpha), double(MicrofacetDistribution::kMaxAlpha));
-    const double a2 = std::max(au, av) * std::max(au, av);
+    const double a2 = clampedAlphas(alphaU, alphaV).a2;
     return kind == MicrofacetKind::GGX ? a2 < 1.0 : 2.0 * a2 - 1.0 <= 0.0;
 }
 
