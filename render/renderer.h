@@ -210,7 +210,7 @@ std::vector<TileRect> imageTiles(int width, int height, int tileSize);
 // thread. Tiles differ in cost (a floor whose cuts reach the cap against a dark wall),
 // and with a few tiles per thread the last heavy ones leave the other threads idle:
 // staircase at 45x80 has 6 tiles of 32 pixels (the CLI's side), and two threads shaded
-// it in 16.6-21.5 s against 24.9 s on one; in 60 tiles of 8, in 14.5-16.1 s. The image
+// it in 16.6-21.5 s against 24.9 s on one; in 60 tiles of 8, in 14.2-16.1 s (once 19.9). The image
 // does not depend on it (renderer_test).
 inline constexpr int kTilesPerThread = 16;
 inline constexpr int kMinBalancedTileSize = 4;
