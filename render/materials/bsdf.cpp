@@ -517,8 +517,8 @@ ClampedAlphas clampedAlphas(double alphaU, double alphaV) {
 // The largest D over normals whose angle to n lies in [thetaLow, thetaHigh] (within
 // [0, pi/2]), from the isotropic majorant of bsdf.h's derivation.
 double microfacetMaximum(MicrofacetKind kind, double alphaU, double alphaV, double thetaLow, double thetaHigh) {
-    const auto [au, av, a2] = clampedAlphas(alphaU, alphaV);
-    const double norm = 1.0 / (kPiD * au * av);
+    const ClampedAlphas alphas = clampedAlphas(alphaU, alphaV);
+    const double a2 = alphas.a2, norm = 1.0 / (kPiD * alphas.u * alphas.v);  // a2: captured below
     if (kind == MicrofacetKind::GGX) {
         const auto at = [&](double theta) {
             const double s = std::sin(theta), c = std::cos(theta);
