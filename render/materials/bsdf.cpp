@@ -537,6 +537,9 @@ double microfacetMaximum(MicrofacetKind kind, double alphaU, double alphaV, doub
     return norm * best;
 }
 
+// Pieces of the theta_h range in rough plastic's coupled F D bound (coneBound).
+constexpr int kFresnelPieces = 6;
+
 // Whether microfacetMaximum over [0, thetaHigh] is D's value at theta = 0 whatever
 // thetaHigh: GGX with a^2 < 1 decreases in theta; Beckmann's g decreases for t >= 0
 // when its peak t* = 2 a^2 - 1 is <= 0.
@@ -616,12 +619,38 @@ std::optional<Rgb> PreparedBsdf::coneBound(const Vec3& axis, double halfAngle) c
     // G <= 1 / (1 + Lambda(wo)): Lambda(wi) >= 0.
     const double specular = dMax / (4.0 * wo.z * (1.0 + double(lookups_.lambdaWo)));
     if (b.kind_ == Kind::RoughConductor) return finiteBound(lookups_.specular * float(specular * 1.0001));
-    // Rough plastic.
-    const double fresnelMax =
-        b.eta_ > 1.0f ? double(fresnelDielectric(float(std::cos(0.5 * std::min(gammaMax, kPiD))), b.eta_).reflectance)
-                      : 1.0;
+    // Rough plastic: F D over the cap (bsdf.h). phi = angle(wo, h) <= min(gamma_max / 2,
+    // theta_o + theta_h); F over [0, phi] is at most max(F(0), F(phi)).
+    double fresnelD = dMax;  // eta <= 1: F <= 1
+    if (b.eta_ > 1.0f && thetaLow < 0.5 * kPiD) {
+        const float normal = fresnelDielectric(1.0f, b.eta_).reflectance;
+        const auto fresnelUpTo = [&](double phi) {  // the largest F over angles in [0, phi]
+            const double widened = std::min(0.5 * kPiD, phi + 1e-6);
+            return double(std::max(normal, fresnelDielectric(float(std::cos(widened)), b.eta_).reflectance));
+        };
+        const double phiMax = 0.5 * std::min(gammaMax, kPiD);
+        const double thetaO = std::acos(std::clamp(wo.z, -1.0, 1.0));
+        if (thetaO + thetaLow >= phiMax) {
+            fresnelD = fresnelUpTo(phiMax) * dMax;
+        } else {
+            // Pieces of the theta_h range, doubling in width from half the roughness: on
+            // [t0, t1], D <= its maximum there and F <= fresnelUpTo(theta_o + t1).
+            const ClampedAlphas alphas = clampedAlphas(b.alphaU_, b.alphaV_);
+            double width = 0.5 * std::sqrt(alphas.a2), t0 = thetaLow;
+            fresnelD = 0.0;
+            for (int piece = 0;; ++piece, width *= 2.0) {  // at least one piece, the last reaching thetaHigh
+                const bool last = piece == kFresnelPieces - 1 || thetaO + t0 + width >= phiMax || t0 + width >= thetaHigh;
+                const double t1 = last ? thetaHigh : t0 + width;
+                const double d = microfacetMaximum(b.distribution_, b.alphaU_, b.alphaV_, t0, t1);
+                fresnelD = std::max(fresnelD, d * fresnelUpTo(std::min(phiMax, thetaO + t1)));
+                if (last) break;
+                t0 = t1;
+            }
+        }
+    }
     const double diffuse = (1.0 - double(lookups_.fresnelWo)) * std::max(0.0, cosMax) / (kPiD * double(b.eta_) * double(b.eta_));
-    return finiteBound((lookups_.specular * float(fresnelMax * specular) + lookups_.diffuse * float(diffuse)) * 1.0001f);
+    const double specularFD = fresnelD / (4.0 * wo.z * (1.0 + double(lookups_.lambdaWo)));
+    return finiteBound((lookups_.specular * float(specularFD) + lookups_.diffuse * float(diffuse)) * 1.0001f);
 }
 
 Rgb Bsdf::albedo(const Vec2& uv) const {

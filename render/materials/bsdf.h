@@ -111,13 +111,23 @@ public:
     //             largest at t* = 2 alpha_max^2 - 1 where t* is in range, else at an end.
     // G <= 1 / (1 + Lambda(wo)) (Smith's height-correlated G = 1 / (1 + Lambda_o + Lambda_i)
     // or 0, Lambda >= 0).
-    // Fresnel: the plastic's F(wo.h) with wo.h = cos(gamma / 2) >= cos(gamma_max / 2);
-    // for eta > 1 the unpolarised reflectance grows with the angle (bsdf_test checks
-    // it on a fine grid), so F <= F(cos(min(gamma_max, pi) / 2)); for eta <= 1, F <= 1.
-    // The conductor's F <= 1.
+    // Fresnel: the plastic's F(cos phi), phi = angle(wo, h) = gamma / 2. Two limits:
+    // phi <= gamma_max / 2, and, by the triangle inequality on the sphere,
+    // phi <= angle(wo, n) + angle(n, h) = theta_o + theta_h. For eta > 1 the unpolarised
+    // reflectance has no interior maximum in the angle (it rises, or for eta above about
+    // 3.5 dips below F(0) first; bsdf_test checks both on a fine grid up to eta 40), so
+    // over [0, phi] F <= F^(phi) = max(F(0), F(phi)). Coupled with D: split the theta_h
+    // range into pieces [t0, t1] (6 at most, widths doubling from alpha_max / 2, the last
+    // one reaching theta_h's top); on each, D <= D_max(t0, t1) and
+    // F <= F^(min(gamma_max / 2, theta_o + t1)), so
+    //   F D <= max over the pieces of D_max(t0, t1) F^(min(gamma_max / 2, theta_o + t1))
+    // (phi widened by 1e-6 for eval's float half vector, as theta_h above).
+    // (F at gamma_max / 2 alone is up to 25x larger for a wide cone holding the mirror
+    // direction, where D peaks at theta_h = 0 and F there is F(theta_o).) For eta <= 1,
+    // F <= 1. The conductor's F <= 1.
     // So, with k_s the specular reflectance and wo.z > 0 fixed,
     //   rough conductor  f |cos| = k_s F D G / (4 wo.z) <= k_s D_max G_max / (4 wo.z);
-    //   rough plastic    f |cos| <= k_s F_max D_max G_max / (4 wo.z)
+    //   rough plastic    f |cos| <= k_s (F D)_max G_max / (4 wo.z)
     //                              + rho (1 - F(wo)) cosMax / (pi eta^2)   (1 - F(wi) <= 1).
     // Float evaluation of those terms is covered by a 1.0001 factor (relative
     // errors of a few float steps); rounding of the caller's directions belongs in beta.

@@ -21,7 +21,7 @@
 
 namespace vrl::rpc {
 
-inline constexpr uint32_t kProtocolVersion = 13;         // vrl.v1 ProtocolVersion CURRENT
+inline constexpr uint32_t kProtocolVersion = 14;         // vrl.v1 ProtocolVersion CURRENT
 static_assert(kProtocolVersion == uint32_t(::vrl::v1::PROTOCOL_VERSION_CURRENT),
               "the handshake's protocol version must be the proto's PROTOCOL_VERSION_CURRENT");
 inline constexpr size_t kChunkBytes = 1 << 20;           // streamed blobs: at most 1 MiB per message
