@@ -617,10 +617,13 @@ std::optional<Rgb> PreparedBsdf::coneBound(const Vec3& axis, double halfAngle) c
     const double dMax =
         thetaLow >= 0.5 * kPiD ? 0.0 : microfacetMaximum(b.distribution_, b.alphaU_, b.alphaV_, thetaLow, thetaHigh);
     // G <= 1 / (1 + Lambda(wo)): Lambda(wi) >= 0.
-    const double specular = dMax / (4.0 * wo.z * (1.0 + double(lookups_.lambdaWo)));
-    if (b.kind_ == Kind::RoughConductor) return finiteBound(lookups_.specular * float(specular * 1.0001));
+    const auto specularOf = [&](double d) { return d / (4.0 * wo.z * (1.0 + double(lookups_.lambdaWo))); };
+    if (b.kind_ == Kind::RoughConductor) return finiteBound(lookups_.specular * float(specularOf(dMax) * 1.0001));
     // Rough plastic: F D over the cap (bsdf.h). phi = angle(wo, h) <= min(gamma_max / 2,
-    // theta_o + theta_h); F over [0, phi] is at most max(F(0), F(phi)).
+    // theta_o + theta_h); F over [0, phi] is at most max(F(0), F(phi)). Pieces of the
+    // theta_h range, doubling in width from half the roughness: on [t0, t1], D <= its
+    // maximum there and F <= fresnelUpTo(theta_o + t1). Where theta_o + thetaLow already
+    // reaches phi_max, one piece: dMax F(phi_max).
     double fresnelD = dMax;  // eta <= 1: F <= 1
     if (b.eta_ > 1.0f && thetaLow < 0.5 * kPiD) {
         const float normal = fresnelDielectric(1.0f, b.eta_).reflectance;
@@ -630,26 +633,19 @@ std::optional<Rgb> PreparedBsdf::coneBound(const Vec3& axis, double halfAngle) c
         };
         const double phiMax = 0.5 * std::min(gammaMax, kPiD);
         const double thetaO = std::acos(std::clamp(wo.z, -1.0, 1.0));
-        if (thetaO + thetaLow >= phiMax) {
-            fresnelD = fresnelUpTo(phiMax) * dMax;
-        } else {
-            // Pieces of the theta_h range, doubling in width from half the roughness: on
-            // [t0, t1], D <= its maximum there and F <= fresnelUpTo(theta_o + t1).
-            const ClampedAlphas alphas = clampedAlphas(b.alphaU_, b.alphaV_);
-            double width = 0.5 * std::sqrt(alphas.a2), t0 = thetaLow;
-            fresnelD = 0.0;
-            for (int piece = 0;; ++piece, width *= 2.0) {  // at least one piece, the last reaching thetaHigh
-                const bool last = piece == kFresnelPieces - 1 || thetaO + t0 + width >= phiMax || t0 + width >= thetaHigh;
-                const double t1 = last ? thetaHigh : t0 + width;
-                const double d = microfacetMaximum(b.distribution_, b.alphaU_, b.alphaV_, t0, t1);
-                fresnelD = std::max(fresnelD, d * fresnelUpTo(std::min(phiMax, thetaO + t1)));
-                if (last) break;
-                t0 = t1;
-            }
+        double width = 0.5 * std::sqrt(clampedAlphas(b.alphaU_, b.alphaV_).a2), t0 = thetaLow;
+        fresnelD = 0.0;
+        for (int piece = 0;; ++piece, width *= 2.0) {  // at least one piece, the last reaching thetaHigh
+            const bool last = piece == kFresnelPieces - 1 || thetaO + t0 + width >= phiMax || t0 + width >= thetaHigh;
+            const double t1 = last ? thetaHigh : t0 + width;
+            const double d = piece == 0 && last ? dMax : microfacetMaximum(b.distribution_, b.alphaU_, b.alphaV_, t0, t1);
+            fresnelD = std::max(fresnelD, d * fresnelUpTo(std::min(phiMax, thetaO + t1)));
+            if (last) break;
+            t0 = t1;
         }
     }
     const double diffuse = (1.0 - double(lookups_.fresnelWo)) * std::max(0.0, cosMax) / (kPiD * double(b.eta_) * double(b.eta_));
-    const double specularFD = fresnelD / (4.0 * wo.z * (1.0 + double(lookups_.lambdaWo)));
+    const double specularFD = specularOf(fresnelD);
     return finiteBound((lookups_.specular * float(specularFD) + lookups_.diffuse * float(diffuse)) * 1.0001f);
 }
 
