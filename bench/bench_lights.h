@@ -4,7 +4,7 @@
 #pragma once
 
 #include "render/core/timing.h"
-#include "render/lightcuts/light_tree.h"
+#include "render/lightcuts/tree/light_tree.h"
 #include "render/scene/scene.h"
 #include "render/vrl/light_tracer.h"
 

@@ -1,7 +1,7 @@
 #include "client/render_options.h"
 
 #include "render/renderer.h"
-#include "render/scene/scene_description.h"
+#include "render/description/scene_description.h"
 
 #include <spdlog/spdlog.h>
 

@@ -5,7 +5,7 @@
 #include "client/output_checks.h"
 #include "client/remote_render.h"
 #include "grpc/health/v1/health.grpc.pb.h"
-#include "render/scene/scene_error.h"
+#include "render/description/scene_error.h"
 #include "service/job/scene_bundle.h"
 #include "util/duration.h"
 #include "util/termination_signals.h"

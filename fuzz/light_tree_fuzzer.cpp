@@ -1,5 +1,5 @@
 // libFuzzer target: the light-tree, VRL-set, surface-VPL and job-lights
-// deserialisers (render/lightcuts/light_tree_io.h).
+// deserialisers (render/lightcuts/tree/light_tree_io.h).
 //
 // Every input is given to vrl::deserializeLightTree, vrl::deserializeVrlSet,
 // vrl::deserializeSurfaceVpls and vrl::parseJobLights twice: as it is, and with its last four bytes replaced
@@ -12,7 +12,7 @@
 // data, which cannot happen here). Anything else is reported with
 // VRL_FUZZ_STRICT_EXCEPTIONS=1 (fuzz_common.h).
 #include "fuzz/fuzz_common.h"
-#include "render/lightcuts/light_tree_io.h"
+#include "render/lightcuts/tree/light_tree_io.h"
 
 #include <zlib.h>
 

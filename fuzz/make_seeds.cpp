@@ -2,8 +2,8 @@
 //   make_seeds OUT_DIR  ->  OUT_DIR/light_tree/*.bin, OUT_DIR/scene_bundle/*.pb
 // Built by the fuzz build only (target vrl_fuzz_make_seeds); its output is
 // committed under fuzz/corpus/, so this is run by hand when a format changes.
-#include "render/lightcuts/light_tree.h"
-#include "render/lightcuts/light_tree_io.h"
+#include "render/lightcuts/tree/light_tree.h"
+#include "render/lightcuts/tree/light_tree_io.h"
 #include "service/job/scene_bundle.h"
 
 #include <zlib.h>

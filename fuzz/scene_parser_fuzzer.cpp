@@ -13,7 +13,7 @@
 // with VRL_FUZZ_STRICT_EXCEPTIONS=1 (fuzz_common.h).
 #include "fuzz/fuzz_common.h"
 #include "render/scene/scene.h"
-#include "render/scene/scene_error.h"
+#include "render/description/scene_error.h"
 #include "render/scene_io/mitsuba/mitsuba_parser.h"
 
 #include <cstddef>

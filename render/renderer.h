@@ -12,9 +12,9 @@
 
 #include "render/image/image.h"
 #include "render/integrators/transport_parts.h"
-#include "render/lightcuts/light_tree.h"
-#include "render/lightcuts/surface_vpl_cut.h"
-#include "render/lightcuts/vrl_cut.h"
+#include "render/lightcuts/tree/light_tree.h"
+#include "render/lightcuts/cuts/surface_vpl_lightcuts_estimator.h"
+#include "render/lightcuts/cuts/lightcuts_estimator.h"
 #include "render/sample_passes.h"
 #include "render/sample_sums.h"
 #include "render/scene/scene.h"
@@ -43,13 +43,13 @@ namespace vrl {
 //         the distance samples; the brute force VPL Lightcuts is measured against)
 //   vrl-stochastic: stochastic VRL Lightcuts: parts (c) and (d) by stochastic cuts
 //         of cut.stochasticCutSize nodes through the VRL light tree, one VRL drawn
-//         under each node (lightcuts/stochastic_vrl_cut.h): unbiased against plain
+//         under each node (lightcuts/cuts/stochastic_lightcuts_estimator.h): unbiased against plain
 //         VRLs; estimated per camera sample, so --spp applies to (c) and (d) too.
 //         Its counter layers are "eval", "importance", "cut" (and "medium-surface-eval",
 //         "-importance", "-cut"): VRL estimates, node importances computed and cut
 //         size, per pixel and camera sample.
 //   vpl-lightcuts: the same layers as vrl-lightcuts, multiple scattering by VPL
-//         Lightcuts (the paper's baseline, lightcuts/vpl_cut.h)
+//         Lightcuts (the paper's baseline, lightcuts/cuts/vpl_lightcuts_estimator.h)
 // For vpl and vpl-lightcuts, vrlCount counts VPLs.
 enum class RenderMethod { Path, Vrl, VrlLightcuts, VrlStochastic, Vpl, VplLightcuts };
 inline constexpr std::array<RenderMethod, 6> kRenderMethods = {RenderMethod::Path,          RenderMethod::Vrl,
@@ -169,7 +169,7 @@ void validateRenderSettings(const RenderSettings& settings);
 // its VRLs). Empty for the path tracer and when neither part (c) nor (d) is selected.
 // vrl-stochastic with vrlSets P > 1: `tree` is set 0's and moreTrees sets 1 ... P-1.
 // Surface VPLs (part (b)'s surface light, vrl and vrl-lightcuts): `surfaceVpls`,
-// with its own tree for vrl-lightcuts (surface_vpl_cut.h).
+// with its own tree for vrl-lightcuts (surface_vpl_lightcuts_estimator.h).
 struct RenderLights {
     VrlSet vrls;
     LightTree tree;

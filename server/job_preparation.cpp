@@ -1,8 +1,8 @@
 #include "server/job_preparation.h"
 
 #include "render/core/timing.h"
-#include "render/lightcuts/light_tree_io.h"
-#include "render/scene/scene_description.h"
+#include "render/lightcuts/tree/light_tree_io.h"
+#include "render/description/scene_description.h"
 #include "service/common/rpc_common.h"
 #include "service/job/job_scene.h"
 #include "service/job/scene_bundle.h"

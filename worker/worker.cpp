@@ -1,6 +1,6 @@
 #include "worker/worker.h"
 
-#include "render/lightcuts/light_tree_io.h"
+#include "render/lightcuts/tree/light_tree_io.h"
 #include "service/job/job_scene.h"
 #include "service/job/scene_bundle.h"
 #include "util/atomic_file.h"

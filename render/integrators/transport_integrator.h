@@ -13,7 +13,7 @@
 //       VPLs, with the inverse square clamped at distance R
 //       (surface_vpl_estimator.h): per camera sample, at that sample's x1, a
 //       stochastic cut of kSurfaceVplSamples VPLs drawn down their tree in
-//       proportion to their bound (surface_vpl_cut.h), unbiased. Per sample, not
+//       proportion to their bound (surface_vpl_lightcuts_estimator.h), unbiased. Per sample, not
 //       once per pixel: the sample's own x1 averages the pixel's footprint as the
 //       path tracer does (once per pixel, a pixel half on a lamp's bright inside
 //       came out either bright or dark). The path-traced part keeps x2's
@@ -27,12 +27,12 @@
 //       function, path-traced from the surface it reaches, no emission there).
 //       With surface VPLs (vrl, vrl-lightcuts: surface_vpl.h), the light that
 //       x2 reflects by a non-Dirac lobe comes instead from every surface VPL,
-//       or a cut over them (surface_vpl_cut.h), against each camera segment,
+//       or a cut over them (surface_vpl_lightcuts_estimator.h), against each camera segment,
 //       once per pixel; the path-traced part keeps the Dirac lobes at x2
 //       (PathStart::diracAtFirstSurfaceOnly), the complement;
 //   (c) x1 on a surface, x2 in a medium: VRL-lit surfaces: every VRL
-//       (VrlSurfaceEstimator), a cut through the VRL tree (surface_vrl_cut.h)
-//       or a stochastic cut (stochastic_vrl_cut.h) at x1; once per pixel with
+//       (VrlSurfaceEstimator), a cut through the VRL tree (surface_lightcuts_estimator.h)
+//       or a stochastic cut (stochastic_lightcuts_estimator.h) at x1; once per pixel with
 //       jittered rays, the VRLs are interleaved over 2 x 2 points x1 of the
 //       pixel instead (interleaved_points.h; vrl-stochastic, per camera
 //       sample, keeps the sample's own x1); the VPL methods path-trace it
@@ -51,12 +51,12 @@
 #include "render/integrators/path_tracer.h"
 #include "render/integrators/pixel_footprint.h"
 #include "render/integrators/transport_parts.h"
-#include "render/lightcuts/light_tree.h"
-#include "render/lightcuts/vpl_cut.h"
-#include "render/lightcuts/stochastic_vrl_cut.h"
-#include "render/lightcuts/surface_vpl_cut.h"
-#include "render/lightcuts/surface_vrl_cut.h"
-#include "render/lightcuts/vrl_cut.h"
+#include "render/lightcuts/tree/light_tree.h"
+#include "render/lightcuts/cuts/vpl_lightcuts_estimator.h"
+#include "render/lightcuts/cuts/stochastic_lightcuts_estimator.h"
+#include "render/lightcuts/cuts/surface_vpl_lightcuts_estimator.h"
+#include "render/lightcuts/cuts/surface_lightcuts_estimator.h"
+#include "render/lightcuts/cuts/lightcuts_estimator.h"
 #include "render/vrl/interleaved_points.h"
 #include "render/vrl/vrl.h"
 #include "render/vrl/vrl_estimator.h"
@@ -76,7 +76,7 @@ struct TransportIntegratorSettings {
     // The lights are VPLs: (d) is VPL Lightcuts over the tree, or plain VPLs without one.
     bool vpls = false;
     int vplDistanceSamples = kDefaultVplDistanceSamples;  // distance samples per camera segment (VPLs)
-    // With a tree: (c), (d) by stochastic cuts (stochastic_vrl_cut.h) of cut.stochasticCutSize nodes.
+    // With a tree: (c), (d) by stochastic cuts (stochastic_lightcuts_estimator.h) of cut.stochasticCutSize nodes.
     bool stochastic = false;
     // (b)'s surface VPLs by a cut over their tree (vrl-lightcuts), else every VPL; part
     // (a) samples them down that tree in both.

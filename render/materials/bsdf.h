@@ -21,7 +21,7 @@
 #include "render/core/geometry.h"
 #include "render/core/rgb.h"
 #include "render/materials/texture.h"
-#include "render/scene/scene_description.h"
+#include "render/description/scene_description.h"
 
 #include <optional>
 #include <span>

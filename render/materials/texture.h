@@ -7,7 +7,7 @@
 
 #include "render/core/geometry.h"
 #include "render/core/rgb.h"
-#include "render/scene/scene_description.h"
+#include "render/description/scene_description.h"
 
 #include <memory>
 #include <vector>

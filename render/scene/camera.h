@@ -10,7 +10,7 @@
 #pragma once
 
 #include "render/core/geometry.h"
-#include "render/scene/scene_description.h"
+#include "render/description/scene_description.h"
 
 #include <Imath/ImathMatrix.h>
 

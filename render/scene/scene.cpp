@@ -1,6 +1,6 @@
 #include "render/scene/scene.h"
 
-#include "render/scene_io/meshes/shape_mesh.h"
+#include "render/shapes/shape_mesh.h"
 
 #include <Imath/ImathBox.h>
 #include <embree3/rtcore.h>

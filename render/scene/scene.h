@@ -14,7 +14,7 @@
 #include "render/materials/texture.h"
 #include "render/media/homogeneous_medium.h"
 #include "render/scene/camera.h"
-#include "render/scene/scene_description.h"
+#include "render/description/scene_description.h"
 
 #include <memory>
 #include <optional>

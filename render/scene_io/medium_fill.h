@@ -9,7 +9,7 @@
 // approximation, listed in SceneDescription::approximations when it applies).
 #pragma once
 
-#include "render/scene/scene_description.h"
+#include "render/description/scene_description.h"
 
 #include <string_view>
 

@@ -25,7 +25,7 @@
 // consecutive pieces of one light path, close in space), so a pixel half on each
 // side of an edge gets half its lights from each side instead of all from one.
 // Exactly so for the plain sum and for a cut at threshold 0 (every VRL reached).
-// A cut (surface_vrl_cut.h) estimates each node at its representative's point; a
+// A cut (surface_lightcuts_estimator.h) estimates each node at its representative's point; a
 // node and the child that shares its representative are then evaluated at the same
 // point, as the walk's inherited estimates require (cut_walk.h). Its bound is the
 // largest of its bounds at the points: each is Phi_C times the most a unit of flux

@@ -24,7 +24,7 @@
 //   beta T_m(t) sigma_s f_p T_r V Phi f_s (theta_B - theta_A) / h,
 // where (theta_B - theta_A) / h = integral_0^S dt / |u(t) - y|^2 <= min(S / d_s^2, pi / d_l),
 // d_s the distance from y to the segment and d_l to its line (the facts the
-// cluster bound of surface_vpl_cut.h uses).
+// cluster bound of surface_vpl_lightcuts_estimator.h uses).
 // Degenerate cases:
 //   - zero-length segment: 0.
 //   - y on the segment's line (h -> 0; only where the camera segment ends on
@@ -95,7 +95,7 @@ public:
 
     // One estimate of the radiance the VPL sends through `segment` to the camera
     // (times segment.throughputBefore), with `flux` in place of vpl.flux (a
-    // cluster's flux for a representative, surface_vpl_cut.h).
+    // cluster's flux for a representative, surface_vpl_lightcuts_estimator.h).
     Rgb contribution(const SurfaceVpl& vpl, const Rgb& flux, const CameraSegment& segment, Rng& rng) const {
         return contribution(vpl, prepareAt(vpl), flux, segment, rng);
     }

@@ -3,7 +3,7 @@
 #include "render/scene_io/medium_fill.h"
 #include "service/common/rpc_common.h"
 
-#include "render/scene/scene_description.h"
+#include "render/description/scene_description.h"
 #include "render/scene_io/mitsuba/mitsuba_parser.h"
 #include "util/strings.h"
 

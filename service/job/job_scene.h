@@ -10,7 +10,7 @@
 
 #include "render/renderer.h"
 #include "render/scene/scene.h"
-#include "render/scene/scene_description.h"
+#include "render/description/scene_description.h"
 #include "service/common/limits.h"
 #include "vrl/v1/vrl.pb.h"
 

@@ -10,7 +10,14 @@
   5. util/ includes nothing outside util/ (leaf helpers);
   6. no cycle between files;
   7. outside render/scene_io/mitsuba/ (and the tests and fuzzers that probe it),
-     only its public header, mitsuba_parser.h, is included.
+     only its public header, mitsuba_parser.h, is included;
+  8. render/'s floor plan runs one way down (RENDER_FLOORS): a folder includes
+     its own files and folders on lower floors only, never a folder on its own
+     floor or above. So scene/ does not include scene_io/ (they share a floor:
+     the parser writes descriptions, the scene builds from them), materials/ does
+     not include scene/, vrl/ does not include lightcuts/; inside lightcuts/ the
+     rooms run tree/ -> bounds/ -> cuts/. A render/ folder missing from
+     RENDER_FLOORS is itself a violation, so a new one is placed on purpose.
 
 Project includes are written from the repository root ("render/core/rgb.h");
 generated API headers ("vrl/v1/vrl.pb.h", "grpc/health/v1/health.pb.h") count
@@ -26,6 +33,21 @@ SOURCE_EXTENSIONS = ('.h', '.hpp', '.cpp', '.cc')
 SKIP_DIRS = {'.git', 'build', 'docs'}
 MITSUBA_PRIVATE = 'render/scene_io/mitsuba/'
 MITSUBA_PUBLIC = 'render/scene_io/mitsuba/mitsuba_parser.h'
+# render/'s folders, lowest floor first; the files directly under render/
+# (renderer.h, the front door) stand on top. Folders on one floor are siblings
+# that must not include each other.
+RENDER_FLOORS = [
+    ['core'],
+    ['description'],
+    ['media', 'materials', 'lights', 'shapes', 'image'],
+    ['scene', 'scene_io'],
+    ['vrl'],
+    ['lightcuts/tree'],
+    ['lightcuts/bounds'],
+    ['lightcuts/cuts'],
+    ['integrators'],
+]
+FRONT_DOOR = '(front door)'
 INCLUDE = re.compile(r'^\s*#\s*include\s*"([^"]+)"')
 
 
@@ -43,6 +65,44 @@ def part_of(path):
 
 def in_render(part):
     return part in ('render', 'render/core')
+
+
+def render_room(path):
+    """The render/ folder a file or include path belongs to ('scene', 'lightcuts/cuts',
+    FRONT_DOOR for files directly under render/), or None outside render/."""
+    if not path.startswith('render/'):
+        return None
+    parts = path.split('/')[1:-1]
+    if not parts:
+        return FRONT_DOOR
+    if parts[0] == 'lightcuts' and len(parts) > 1:
+        return 'lightcuts/' + parts[1]
+    return parts[0]
+
+
+def floor_of(room):
+    if room == FRONT_DOOR:
+        return len(RENDER_FLOORS)
+    for number, rooms in enumerate(RENDER_FLOORS):
+        if room in rooms:
+            return number
+    return None
+
+
+def floor_violation(source, included):
+    """Rule 8 for a file `source` including `included`, or None."""
+    source_room, included_room = render_room(source), render_room(included)
+    if source_room is None or included_room is None or source_room == included_room:
+        return None
+    for room in (source_room, included_room):
+        if floor_of(room) is None:
+            return 'render/%s/ is on no floor of the render floor plan (add it to RENDER_FLOORS)' % room
+    source_floor, included_floor = floor_of(source_room), floor_of(included_room)
+    if included_floor < source_floor:
+        return None
+    where = 'on its own floor' if included_floor == source_floor else 'above it'
+    return 'render/%s/ must not include render/%s/ (%s: the render floor plan runs one way down)' % (
+        source_room, included_room, where)
 
 
 def violation(source_part, include_part):
@@ -134,7 +194,7 @@ def check(root):
     for source, includes in sorted(files.items()):
         source_part = part_of(source)
         for number, included in includes:
-            problem = violation(source_part, part_of(included))
+            problem = violation(source_part, part_of(included)) or floor_violation(source, included)
             if (not problem and included.startswith(MITSUBA_PRIVATE) and included != MITSUBA_PUBLIC
                     and not source.startswith((MITSUBA_PRIVATE, 'tests/', 'fuzz/'))):
                 problem = 'only ' + MITSUBA_PUBLIC + ' of render/scene_io/mitsuba/ is public'

@@ -40,6 +40,14 @@ CLEAN = {
     'render/scene_io/mitsuba/xml_values.h': '#pragma once\n',
     'render/renderer.h': '#include "render/scene_io/mitsuba/mitsuba_parser.h"\n',
     'tests/render/xml_values_test.cpp': '#include "render/scene_io/mitsuba/xml_values.h"\n',
+    'render/description/scene_description.h': '#include "render/core/rgb.h"\n',
+    'render/materials/bsdf.h': '#include "render/description/scene_description.h"\n',
+    'render/shapes/shape_mesh.h': '#include "render/description/scene_description.h"\n',
+    'render/vrl/vrl.h': '#include "render/scene/scene.h"\n#include "render/materials/bsdf.h"\n',
+    'render/lightcuts/tree/light_tree.h': '#include "render/vrl/vrl.h"\n',
+    'render/lightcuts/bounds/cluster_bound.h': '#include "render/lightcuts/tree/light_tree.h"\n',
+    'render/lightcuts/cuts/lightcuts_estimator.h': '#include "render/lightcuts/bounds/cluster_bound.h"\n',
+    'render/integrators/transport_integrator.h': '#include "render/lightcuts/cuts/lightcuts_estimator.h"\n',
 }
 
 BROKEN = [
@@ -54,6 +62,18 @@ BROKEN = [
     ('util/hash.h', '#include "render/core/rgb.h"\n', 'util/ must include nothing outside util/'),
     ('render/scene/a.h', '#include "render/scene/b.h"\n', 'include cycle'),
     ('render/renderer.h', '#include "render/scene_io/mitsuba/xml_values.h"\n', 'only render/scene_io/mitsuba/mitsuba_parser.h'),
+    # The render floor plan (rule 8): the named back-arrows, a sideways one, an unplaced folder.
+    ('render/scene/scene.h', '#include "render/scene_io/mitsuba/mitsuba_parser.h"\n',
+     'render/scene/ must not include render/scene_io/'),
+    ('render/materials/bsdf.h', '#include "render/scene/scene.h"\n', 'render/materials/ must not include render/scene/'),
+    ('render/vrl/vrl.h', '#include "render/lightcuts/tree/light_tree.h"\n', 'render/vrl/ must not include render/lightcuts/tree/'),
+    ('render/lightcuts/tree/light_tree.h', '#include "render/lightcuts/cuts/lightcuts_estimator.h"\n',
+     'render/lightcuts/tree/ must not include render/lightcuts/cuts/'),
+    ('render/core/rgb.h', '#include "render/renderer.h"\n', 'render/core/ must include nothing outside'),
+    ('render/integrators/transport_integrator.h', '#include "render/renderer.h"\n',
+     'render/integrators/ must not include render/(front door)/'),
+    ('render/shapes/shape_mesh.h', '#include "render/materials/bsdf.h"\n', 'render/shapes/ must not include render/materials/ (on its own floor'),
+    ('render/gadgets/gadget.h', '#include "render/core/rgb.h"\n', 'render/gadgets/ is on no floor'),
 ]
 
 

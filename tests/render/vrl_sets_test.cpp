@@ -6,7 +6,7 @@
 // and independent sets are independent draws of the light tracer, so their mean
 // converges to the true transport; these tests pin down the bookkeeping that
 // this argument needs (distinct sets, the sample-to-set rule, determinism).
-#include "render/lightcuts/light_tree_io.h"
+#include "render/lightcuts/tree/light_tree_io.h"
 #include "render/renderer.h"
 #include "tests/support/image_compare.h"
 #include "tests/support/test_scenes.h"

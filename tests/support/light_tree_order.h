@@ -4,7 +4,7 @@
 // visit nodes in this order.
 #pragma once
 
-#include "render/lightcuts/light_tree.h"
+#include "render/lightcuts/tree/light_tree.h"
 
 #include <utility>
 #include <vector>

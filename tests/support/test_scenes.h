@@ -2,7 +2,7 @@
 // each with a known answer.
 #pragma once
 
-#include "render/scene/scene_description.h"
+#include "render/description/scene_description.h"
 
 namespace vrl::test {
 

@@ -20,7 +20,7 @@
 #include <unordered_set>
 #include <vector>
 
-#include "render/scene/scene_description.h"
+#include "render/description/scene_description.h"
 #include "render/scene_io/mitsuba/mitsuba_parser.h"
 #include "render/scene_io/mitsuba/xml_values.h"
 

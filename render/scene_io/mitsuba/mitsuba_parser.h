@@ -52,7 +52,7 @@
 #include <optional>
 #include <string>
 
-#include "render/scene/scene_description.h"
+#include "render/description/scene_description.h"
 
 namespace vrl {
 

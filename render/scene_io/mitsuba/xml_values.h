@@ -25,7 +25,7 @@
 #include "render/core/geometry.h"
 #include "render/core/rgb.h"
 #include "render/core/transform.h"
-#include "render/scene/scene_error.h"
+#include "render/description/scene_error.h"
 
 namespace vrl::xml {
 

@@ -28,10 +28,10 @@
 // 4. Exact minimum distances for small nodes.
 //
 // All streams have fixed seeds; sample counts are stated with each test.
-#include "render/lightcuts/cluster_bound.h"
+#include "render/lightcuts/bounds/cluster_bound.h"
 
 #include "render/core/rng.h"
-#include "render/lightcuts/light_tree.h"
+#include "render/lightcuts/tree/light_tree.h"
 #include "render/scene/scene.h"
 #include "render/vrl/vrl_estimator.h"
 #include "tests/support/test_scenes.h"

@@ -18,8 +18,8 @@
 //   at most as many, each node checked against the bound it last had), with fewer
 //   tight bounds computed.
 #include "render/core/rng.h"
-#include "render/lightcuts/cut_walk.h"
-#include "render/lightcuts/light_tree.h"
+#include "render/lightcuts/cuts/cut_walk.h"
+#include "render/lightcuts/tree/light_tree.h"
 
 #include <gtest/gtest.h>
 

@@ -1,13 +1,13 @@
-// Tests of DirectionCone and DirectionCones (render/lightcuts/direction_cone.h):
+// Tests of DirectionCone and DirectionCones (render/lightcuts/bounds/direction_cone.h):
 // every VRL direction below a node lies in the node's cone, through rounding, and
 // merged cones are not needlessly wide. Random trees of VRLs with directions that
 // are random, nearly equal (spread 1e-7..1e-2 rad), exactly opposite, or
 // axis-aligned; seeds fixed (Rng(201, tree)). Containment is an exact test in
 // double: zero misses are required.
-#include "render/lightcuts/direction_cone.h"
+#include "render/lightcuts/bounds/direction_cone.h"
 
 #include "render/core/rng.h"
-#include "render/lightcuts/light_tree.h"
+#include "render/lightcuts/tree/light_tree.h"
 
 #include <gtest/gtest.h>
 

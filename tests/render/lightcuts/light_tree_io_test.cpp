@@ -1,4 +1,4 @@
-#include "render/lightcuts/light_tree_io.h"
+#include "render/lightcuts/tree/light_tree_io.h"
 
 #include "render/core/rng.h"
 

@@ -8,8 +8,8 @@
 // (binomial tests); determinism across thread counts and seeds; a bit-exact
 // serialisation round trip; and the hybrid build's cost against the global one.
 #include "render/core/rng.h"
-#include "render/lightcuts/light_tree.h"
-#include "render/lightcuts/light_tree_io.h"
+#include "render/lightcuts/tree/light_tree.h"
+#include "render/lightcuts/tree/light_tree_io.h"
 #include "render/vrl/light_tracer.h"
 #include "tests/support/test_scenes.h"
 

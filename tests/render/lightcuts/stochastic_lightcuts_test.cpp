@@ -1,5 +1,5 @@
 // Tests of stochastic VRL Lightcuts (stochastic_cut.h, vrl_importance.h,
-// stochastic_vrl_cut.h): unbiased against plain VRLs over the same VRL set.
+// stochastic_lightcuts_estimator.h): unbiased against plain VRLs over the same VRL set.
 //
 // Reachability: for random trees and random camera segments (lines through
 // node boxes, along a VRL's own line, starting inside the VRLs' region) and
@@ -21,9 +21,9 @@
 // HG g = 0.7 media, with surfaces (the lit room) and without (the medium cube);
 // within 5 combined standard errors of the seed means (Student t with 63 dof
 // for the dominant term, P(|t| > 5) = 5e-6 each).
-#include "render/lightcuts/stochastic_cut.h"
-#include "render/lightcuts/stochastic_vrl_cut.h"
-#include "render/lightcuts/vrl_importance.h"
+#include "render/lightcuts/cuts/stochastic_cut.h"
+#include "render/lightcuts/cuts/stochastic_lightcuts_estimator.h"
+#include "render/lightcuts/cuts/vrl_importance.h"
 #include "render/renderer.h"
 #include "render/scene/scene.h"
 #include "render/vrl/vrl_estimator.h"

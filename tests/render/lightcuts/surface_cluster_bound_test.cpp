@@ -16,10 +16,10 @@
 // deferred bound). The corners heuristic (GlossyBound::Corners) prints its violation
 // rate, capped at 0.1%.
 // Fixed seeds throughout; the largest estimate / bound ratio is printed.
-#include "render/lightcuts/surface_cluster_bound.h"
+#include "render/lightcuts/bounds/surface_cluster_bound.h"
 
 #include "render/core/rng.h"
-#include "render/lightcuts/light_tree.h"
+#include "render/lightcuts/tree/light_tree.h"
 #include "render/scene/scene.h"
 #include "render/vrl/vrl_surface_estimator.h"
 #include "tests/support/test_scenes.h"

@@ -1,4 +1,4 @@
-// Tests of the surface-VPL Lightcuts (part (b), surface_vpl_cut.h): the node
+// Tests of the surface-VPL Lightcuts (part (b), surface_vpl_lightcuts_estimator.h): the node
 // bound and the cut against plain shading over the same prepared VPLs; at the
 // end, for the second receiver, a camera path's surface point (part (a)): its
 // bound and its stochastic sampling.
@@ -37,11 +37,11 @@
 // from the light tracer (LightTracingSettings::surfaceVpls) in the
 // room with an occluder, grey isotropic and chromatic HG (g = 0.6) smoke; camera
 // segments of the scene's 16 x 16 camera, one ray per pixel centre.
-#include "render/lightcuts/surface_vpl_cut.h"
+#include "render/lightcuts/cuts/surface_vpl_lightcuts_estimator.h"
 
 #include "render/core/rng.h"
-#include "render/lightcuts/light_tree.h"
-#include "render/lightcuts/stochastic_cut.h"
+#include "render/lightcuts/tree/light_tree.h"
+#include "render/lightcuts/cuts/stochastic_cut.h"
 #include "render/scene/scene.h"
 #include "render/vrl/camera_segment.h"
 #include "render/vrl/light_tracer.h"

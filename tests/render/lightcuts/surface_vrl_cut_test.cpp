@@ -1,4 +1,4 @@
-// Part (c)'s cut over interleaved points (interleaved_points.h, surface_vrl_cut.h):
+// Part (c)'s cut over interleaved points (interleaved_points.h, surface_lightcuts_estimator.h):
 // four points of a diffuse sphere in fog (one of them absent, as where a pixel's
 // stratum sees no surface), 3000 random VRLs in a tree, fixed seeds.
 //  - At threshold 0 the cut reaches every VRL, and VRL k is evaluated at point
@@ -22,10 +22,10 @@
 //    is not taken as the cut point, and at threshold 0.01 the result stays within
 //    5% of the plain interleaved sum (with that point's bound alone it was off by
 //    99%: the cut stopped almost at once).
-#include "render/lightcuts/surface_vrl_cut.h"
+#include "render/lightcuts/cuts/surface_lightcuts_estimator.h"
 
 #include "render/core/rng.h"
-#include "render/lightcuts/light_tree.h"
+#include "render/lightcuts/tree/light_tree.h"
 #include "render/scene/scene.h"
 #include "render/vrl/vrl_estimator.h"
 #include "tests/support/test_scenes.h"

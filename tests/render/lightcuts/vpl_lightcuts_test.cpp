@@ -1,11 +1,11 @@
-// VPL Lightcuts (the paper's baseline, render/lightcuts/vpl_cut.h): the box distance, VPL
+// VPL Lightcuts (the paper's baseline, render/lightcuts/cuts/vpl_lightcuts_estimator.h): the box distance, VPL
 // deposition by the light tracer against the VRLs of the same light paths, the
 // point-cluster light tree, the exactness of a cut at error threshold 0, the
 // conservativeness of the node bound, and the rendered part (d) against plain
 // VRLs over the same light paths, plus determinism.
 #include "render/core/rng.h"
-#include "render/lightcuts/light_tree.h"
-#include "render/lightcuts/vpl_cut.h"
+#include "render/lightcuts/tree/light_tree.h"
+#include "render/lightcuts/cuts/vpl_lightcuts_estimator.h"
 #include "render/renderer.h"
 #include "render/scene/scene.h"
 #include "render/vrl/light_tracer.h"

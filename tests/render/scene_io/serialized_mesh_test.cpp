@@ -3,7 +3,7 @@
 // no offset table), every rejected input (missing file, bad format id, wrong version, shape
 // index out of range, corrupt and truncated zlib data, counts that do not fit, indices out
 // of range, NaN positions), and the real bidir.serialized of the veach-lamp scene.
-#include "render/scene_io/meshes/serialized_mesh.h"
+#include "render/shapes/serialized_mesh.h"
 
 #include <gtest/gtest.h>
 #include <zlib.h>

@@ -4,7 +4,7 @@
 // mirroring transforms, watertightness of closed shapes, Mitsuba's texture
 // coordinates of the analytic shapes, OBJ quads, polygons, mixed face formats and
 // vt, .serialized shapes (written here with zlib), and mesh-file errors.
-#include "render/scene_io/meshes/shape_mesh.h"
+#include "render/shapes/shape_mesh.h"
 
 #include <gtest/gtest.h>
 #include <zlib.h>

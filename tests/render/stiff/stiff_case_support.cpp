@@ -1,7 +1,7 @@
 #include "tests/render/stiff/stiff_case_support.h"
 
-#include "render/lightcuts/cluster_bound.h"
-#include "render/lightcuts/vrl_cut.h"
+#include "render/lightcuts/bounds/cluster_bound.h"
+#include "render/lightcuts/cuts/lightcuts_estimator.h"
 #include "tests/support/test_scenes.h"
 
 #include <algorithm>

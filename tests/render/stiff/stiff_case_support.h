@@ -22,7 +22,7 @@
 #pragma once
 
 #include "render/core/rng.h"
-#include "render/lightcuts/light_tree.h"
+#include "render/lightcuts/tree/light_tree.h"
 #include "render/renderer.h"
 #include "render/scene/scene.h"
 #include "render/vrl/vrl_estimator.h"

@@ -5,9 +5,9 @@
 #include "tests/render/stiff/stiff_case_groups.h"
 #include "tests/render/stiff/stiff_case_support.h"
 
-#include "render/lightcuts/cluster_bound.h"
-#include "render/lightcuts/vpl_cut.h"
-#include "render/lightcuts/vrl_cut.h"
+#include "render/lightcuts/bounds/cluster_bound.h"
+#include "render/lightcuts/cuts/vpl_lightcuts_estimator.h"
+#include "render/lightcuts/cuts/lightcuts_estimator.h"
 #include "tests/support/test_scenes.h"
 
 #include <algorithm>

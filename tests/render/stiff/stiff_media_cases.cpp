@@ -6,7 +6,7 @@
 #include "tests/render/stiff/stiff_case_groups.h"
 #include "tests/render/stiff/stiff_case_support.h"
 
-#include "render/lightcuts/cluster_bound.h"
+#include "render/lightcuts/bounds/cluster_bound.h"
 #include "tests/support/test_scenes.h"
 
 #include <algorithm>

@@ -5,8 +5,8 @@
 #include "tests/render/stiff/stiff_case_groups.h"
 #include "tests/render/stiff/stiff_case_support.h"
 
-#include "render/lightcuts/vpl_cut.h"
-#include "render/lightcuts/vrl_cut.h"
+#include "render/lightcuts/cuts/vpl_lightcuts_estimator.h"
+#include "render/lightcuts/cuts/lightcuts_estimator.h"
 
 #include <algorithm>
 #include <chrono>
