@@ -49,15 +49,11 @@ std::vector<MethodRun> sweep(bool quick) {
         }
         return runs;
     }
-    // At 320x180 (57,600 pixels) on 2 cores, bathroom: about 0.5 to 20 s a run (the
-    // paper scenes up to 1.6x that). The whole-image runs are a quarter of the spp
-    // they had when the full report took 62 min (its limit is 45): the whole image is
-    // mostly parts (a) and (b), sampled alike by the virtual-light methods, so
-    // fewer samples move every curve alike and keep them above the noise rule's floor.
-    // (Since part (b)'s surface light comes from surface VPLs in plain VRLs and VRL
-    // Lightcuts, their whole-image runs err x0.3-1.0 less, and four veach-lamp runs
-    // fall below its reference's noise; with the tighter bounds and faster kernels
-    // after them the full report took 44.9 min, 49.4 before.)
+    // The whole-image runs take a quarter of part (d)'s spp, so that the full report
+    // fits its 45-minute budget on 2 cores: the whole image is mostly parts (a) and
+    // (b), sampled alike by the virtual-light methods, so fewer samples move every
+    // curve alike and keep them above the noise rule's floor. The report's run times
+    // are in docs/report/summary.md.
     // Each curve spans an order of magnitude in time or more: the spp grow with N,
     // and each curve starts at a cheap point (on bathroom 1-3 s: plain VRLs and VRL
     // Lightcuts at N = 100, stochastic cuts N = 1k, all at 1 spp, VPL Lightcuts at
@@ -123,19 +119,14 @@ std::vector<MethodRun> multipleSweep(bool quick) {
 }
 
 // The full report's cheapest points, rendered kCheapRepeats times: one render's
-// error moves most with the seed there (the previous report, one render a point:
-// its errors moved by a median x1.14 on part (d), x1.24 on the whole image, when
-// the seeds changed) and a repeat costs least. Chosen by setting, none the last
-// of its curve: the whole image's path tracing at 8 and 32 spp, plain VRLs and
-// VRL Lightcuts at N = 100 and the stochastic cuts at 1 spp; part (d)'s
-// plain VRLs at N = 100, VRL Lightcuts at N = 300 (both thresholds) and N = 1k
-// (e = 0.1), the stochastic cuts at 1 spp and K = 8 at 4 spp. All took under
-// 3.5 s a render in the report before repeats but one (bathroom-hg07's VRL
-// Lightcuts at N = 300, 5.4 s). 57 points. The two extra renders of the first 53
-// took the full report from 39.3 to 43.6 min; with all 57 it took 43.5 min, within
-// its 45-minute limit. VPL Lightcuts' D=4 points (2-3 s, added after the repeats
-// were chosen) have one render each: two more renders of their 12 points would
-// cost about 50 s and leave the report under a minute of margin.
+// error moves most with the seed there, and a repeat costs least. Chosen by
+// setting, none the last of its curve: the whole image's path tracing at 8 and
+// 32 spp, plain VRLs and VRL Lightcuts at N = 100 and the stochastic cuts at 1 spp;
+// part (d)'s plain VRLs at N = 100, VRL Lightcuts at N = 300 (both thresholds) and
+// N = 1k (e = 0.1), the stochastic cuts at 1 spp and K = 8 at 4 spp. VPL Lightcuts'
+// D = 4 points have one render each: repeating them would leave the full report too
+// little margin under its 45-minute budget. The measurements behind the choice are
+// in docs/measurements/2026-12-07-tuning-constants.md.
 bool cheapPoint(const MethodRun& r) {
     const bool oneSpp = r.spp == 1;
     if (!r.multipleOnly)

@@ -3,11 +3,11 @@
 // textures of the surface its shading point lies on.
 //
 // Why: part (c) (VRL-lit surfaces) is evaluated once per pixel, at one camera ray
-// jittered inside the pixel (now at 2 x 2 interleaved points, one per quarter:
+// jittered inside the pixel (or at 2 x 2 interleaved points, one per quarter:
 // interleaved_points.h), while the path-sampled parts average the pixel's spp
 // rays. On a textured surface the one point's texel then decides the pixel's value
-// and moves with the jitter: on staircase at its own resolution that was most of
-// (c)'s noise between seeds (crops with the textures made constant lost it).
+// and moves with the jitter, a large share of (c)'s noise between seeds on
+// textured scenes such as staircase (crops with the textures made constant lose it).
 // So the shading point's texture lookups are averaged over the pixel instead
 // (PreparedBsdf::averageTexturesOver), as pbrt filters textures over a ray's
 // footprint: the point keeps its geometry (position, normals, wo), its BSDF takes

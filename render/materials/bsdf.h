@@ -123,8 +123,9 @@ public:
     //   F D <= max over the pieces of D_max(t0, t1) F^(min(gamma_max / 2, theta_o + t1))
     // (phi widened by 1e-6 for eval's float half vector, as theta_h above).
     // (F at gamma_max / 2 alone is far larger for a wide cone holding the mirror
-    // direction, where D peaks at theta_h = 0 and F there is near F(theta_o): bsdf_test's
-    // loosest such bound at alpha 0.1 was 11x the largest value found, now 1.8x.)
+    // direction, where D peaks at theta_h = 0 and F there is near F(theta_o); bsdf_test
+    // checks that the coupled bound stays within a small factor of the largest value
+    // found for such cones.)
     // For eta <= 1, F <= 1. The conductor's F <= 1.
     // So, with k_s the specular reflectance and wo.z > 0 fixed,
     //   rough conductor  f |cos| = k_s F D G / (4 wo.z) <= k_s D_max G_max / (4 wo.z);

@@ -4,9 +4,9 @@
 // Why: (c) is evaluated once per pixel (transport_integrator.h), at one camera
 // ray jittered over the pixel, while the path-sampled parts average spp rays.
 // Where the pixel holds an edge (a stair's nosing, a railing in front of a wall)
-// the one point lands on either side, and the pixel's (c) jumps between seeds:
-// on staircase at its own resolution that was most of (c)'s remaining noise
-// (one crop held 83% of it; with pixel centres, that crop's variance was 1/6).
+// the one point lands on either side, and the pixel's (c) jumps between seeds; on
+// scenes with many edges (staircase at its own resolution) that is most of (c)'s
+// noise (docs/measurements/2026-12-07-tuning-constants.md).
 // Evaluating every VRL (or cut) at each of Q points would cost Q times as much.
 //
 // Contract: Q points x_0..x_{Q-1} (one per stratum of the pixel, any of them

@@ -58,10 +58,10 @@ inline bool lambertianBounded(const Bsdf& bsdf) {
 // Part (a) takes a VPL's light (its point contribution, below) only where the VPL's
 // model reflects broadly: Lambertian-bounded, or a glossy lobe of roughness at least
 // kBroadLobeRoughness. A narrow lobe sends the VPL's light into a small cone, and the
-// few points in it see a spike: with the VPLs on staircase's rough plastic (alpha 0.1,
-// 0.2) taking part, its final image was x1.15 noisier (0.2159 against 0.1877 without
-// glossy VPLs). veach-lamp's light leaves its Ward reflector (alpha 0.4) as VPLs, and
-// leaving those out too made its image x1.24 noisier (0.5047 against 0.4083). The
+// few points in it see a spike, so narrow-lobed VPLs (staircase's rough plastic, alpha
+// 0.1 and 0.2) add noise, while broad ones (veach-lamp's Ward reflector, alpha 0.4)
+// remove it: the threshold sits between them (the measurements behind it are in
+// docs/measurements/2026-12-07-tuning-constants.md). The
 // path tracer carries x2's reflection in full where x2's model is narrow
 // (PathStart::surfaceVplRadius), so the split stays unbiased whatever the threshold.
 inline constexpr float kBroadLobeRoughness = 0.25f;

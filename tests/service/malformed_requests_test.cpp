@@ -214,7 +214,7 @@ void submitJobCases(Harness& h) {
     const std::vector<SpecCase> cases = {
         {"no parameters", [](S& s) { s.clear_parameters(); }, StatusCode::INVALID_ARGUMENT, "no parameters"},
         {"empty spec", [](S& s) { s = S(); s.set_name(kHostileName); }, StatusCode::INVALID_ARGUMENT, "no parameters"},
-        // (An empty method is the headline method since step 9, not an error.)
+        // (An empty method is the headline method, not an error.)
         {"blank method", [&](S& s) { params(s).set_method(" "); }, StatusCode::INVALID_ARGUMENT, "unknown method ' '"},
         {"unknown method", [&](S& s) { params(s).set_method("magic"); }, StatusCode::INVALID_ARGUMENT,
          "unknown method 'magic' (valid: path, vrl, vrl-lightcuts, vrl-stochastic, vpl, vpl-lightcuts)"},

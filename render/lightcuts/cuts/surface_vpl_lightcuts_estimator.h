@@ -95,14 +95,13 @@ Rgb surfaceVplReflectionBound(const Scene& scene, const SurfaceVpl& vpl);
 // the diagonal of the VPLs' bounding box (the lit part of the scene), so that it
 // scales with the scene; 0 without VPLs. Below R the path tracer carries the
 // share the clamp leaves out: a larger R moves more of (a) back to path tracing,
-// a smaller one lets the VPLs' 1/d^2 peak. On veach-lamp (R = 0.144) part (a)'s
-// relative noise was 1.59 / 1.20 / 1.19 at R x 0.25 / 1 / 4. The same VPLs give
-// the same R on every machine.
+// a smaller one lets the VPLs' 1/d^2 peak; part (a)'s noise is flat around this
+// fraction and rises well below it (docs/measurements/2026-12-07-tuning-constants.md).
+// The same VPLs give the same R on every machine.
 inline constexpr float kSurfaceVplRadiusFraction = 0.02f;
-// VPLs drawn per camera sample for part (a) (the stochastic cut's size). Measured
-// on veach-lamp with smoke (64x36, 100 spp, 8 seeds), part (a)'s relative noise
-// 1.24 / 1.20 / 1.14 / 1.13 at 1 / 2 / 4 / 8: the rest of (a)'s noise is the
-// path-traced remainder, so 2.
+// VPLs drawn per camera sample for part (a) (the stochastic cut's size): past 2 the
+// rest of (a)'s noise is the path-traced remainder, so more VPLs cost time and
+// remove little (docs/measurements/2026-12-07-tuning-constants.md).
 inline constexpr uint32_t kSurfaceVplSamples = 2;
 float surfaceVplRadius(const SurfaceVplLights& lights);
 
