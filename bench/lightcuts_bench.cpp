@@ -24,6 +24,7 @@
 // over the heuristic's time: the "slower at equal error" ratio.
 #include "bench/bench_lights.h"
 #include "render/core/timing.h"
+#include "render/description/scene_description.h"
 #include "render/image/image_metrics.h"
 #include "render/integrators/transport_integrator.h"
 #include "render/lightcuts/tree/light_tree.h"
@@ -34,6 +35,7 @@
 #include "render/vrl/light_tracer.h"
 #include "render/vrl/vrl_kernel.h"
 #include "tests/support/test_scenes.h"
+#include "util/command_line.h"
 
 #include <CLI/CLI.hpp>
 #include <spdlog/spdlog.h>
@@ -45,6 +47,8 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <stdexcept>
+#include <tuple>
 #include <vector>
 
 using namespace vrl;
@@ -216,13 +220,13 @@ int main(int argc, char** argv) {
     if (verbose) spdlog::set_level(spdlog::level::debug);
 
     ParseOptions parseOptions;
-    for (const auto& d : defines) {
-        const auto eq = d.find('=');
-        if (eq == std::string::npos) {
-            std::fprintf(stderr, "-D expects name=value, got '%s'\n", d.c_str());
-            return 2;
-        }
-        parseOptions.defines[d.substr(0, eq)] = d.substr(eq + 1);
+    int w = 0, h = 0;
+    try {
+        parseOptions.defines = util::parseDefines(defines);
+        std::tie(w, h) = util::parseResolution(resolution, kMaxFilmSide, kMaxFilmPixels);
+    } catch (const std::invalid_argument& e) {
+        std::fprintf(stderr, "%s\n", e.what());
+        return 2;
     }
     // The built-in test scenes (tests/support/test_scenes.h): `lit-room`, the lit room
     // with its occluder (isotropic, sigma_s 0.4, sigma_a 0.1; -D g=... sets HG), and
@@ -235,11 +239,6 @@ int main(int argc, char** argv) {
         scenePath == "lit-room"   ? test::litRoomWithOccluder(Rgb(0.4f), Rgb(0.1f), builtinG())
         : scenePath == "infinite" ? test::pointLightInInfiniteMedium(Rgb(10.0f), Vec3(0.0f), Rgb(0.4f), Rgb(0.1f), builtinG())
                                   : parseMitsubaScene(scenePath, parseOptions);
-    int w = 0, h = 0;
-    if (std::sscanf(resolution.c_str(), "%dx%d", &w, &h) != 2 || w < 1 || h < 1) {
-        std::fprintf(stderr, "bad --resolution '%s'\n", resolution.c_str());
-        return 2;
-    }
     description.sensor.width = w;
     description.sensor.height = h;
     const auto scene = Scene::build(description);

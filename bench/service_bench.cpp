@@ -9,8 +9,10 @@
 // in its lease and submit handlers. Wall-clock, one run each: compare ratios.
 #include "client/job_client.h"
 #include "render/core/timing.h"
+#include "render/description/scene_description.h"
 #include "server/coordinator_service.h"
 #include "service/job/job_scene.h"
+#include "util/command_line.h"
 #include "util/random_id.h"
 #include "worker/asset_fetcher.h"
 
@@ -25,7 +27,9 @@
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
+#include <stdexcept>
 #include <thread>
+#include <tuple>
 
 extern char** environ;
 
@@ -91,13 +95,19 @@ int main(int argc, char** argv) {
     CLI11_PARSE(app, argc, argv);
     spdlog::set_level(spdlog::level::warn);
 
-    const auto x = resolution.find('x');
+    int width = 0, height = 0;
+    try {
+        std::tie(width, height) = util::parseResolution(resolution, kMaxFilmSide, kMaxFilmPixels);
+    } catch (const std::invalid_argument& e) {
+        std::fprintf(stderr, "%s\n", e.what());
+        return 2;
+    }
     v1::JobSpec spec;
     auto& p = *spec.mutable_parameters();
     p = rpc::defaultRenderParameters(parseRenderMethod(method));
     p.set_samples_per_pixel(spp);
-    p.set_width(uint32_t(std::stoi(resolution.substr(0, x))));
-    p.set_height(uint32_t(std::stoi(resolution.substr(x + 1))));
+    p.set_width(uint32_t(width));
+    p.set_height(uint32_t(height));
     p.set_vrl_count(vrls);
     spec.set_tile_size(uint32_t(tileSize));
     spec.set_name(scene);

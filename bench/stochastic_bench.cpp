@@ -35,6 +35,7 @@
 #include "bench/bench_lights.h"
 #include "bench/stochastic_ceiling.h"
 #include "render/core/timing.h"
+#include "render/description/scene_description.h"
 #include "render/image/image_metrics.h"
 #include "render/integrators/transport_integrator.h"
 #include "render/lightcuts/tree/light_tree.h"
@@ -46,6 +47,7 @@
 #include "render/vrl/camera_segment.h"
 #include "render/vrl/light_tracer.h"
 #include "render/vrl/vrl_estimator.h"
+#include "util/command_line.h"
 
 #include <CLI/CLI.hpp>
 #include <tbb/parallel_for.h>
@@ -56,6 +58,7 @@
 #include <cstdio>
 #include <mutex>
 #include <stdexcept>
+#include <tuple>
 
 using namespace vrl;
 
@@ -78,7 +81,8 @@ Shading shade(const Scene& scene, const VrlSet& vrls, const LightTree& tree, Met
     settings.transports = TransportSelection::parse(surfacePart ? "medium-surface" : "multiple");
     settings.cut.errorThreshold = error;
     settings.cut.stochasticCutSize = uint32_t(cutSize);
-    settings.stochastic = method == Method::Stochastic;
+    if (method == Method::Stochastic)
+        settings.estimators = {MediumGathererKind::StochasticVrlCut, SurfaceGathererKind::StochasticVrlCut};
     const TransportIntegrator integrator(scene, vrls, settings, method == Method::Plain ? nullptr : &tree);
     const PerspectiveCamera& camera = scene.camera();
     Shading out;
@@ -412,21 +416,16 @@ int main(int argc, char** argv) {
     }
 
     ParseOptions parseOptions;
-    for (const auto& d : defines) {
-        const auto eq = d.find('=');
-        if (eq == std::string::npos) {
-            std::fprintf(stderr, "-D expects name=value, got '%s'\n", d.c_str());
-            return 2;
-        }
-        parseOptions.defines[d.substr(0, eq)] = d.substr(eq + 1);
+    int w = 0, h = 0;
+    try {
+        parseOptions.defines = util::parseDefines(defines);
+        std::tie(w, h) = util::parseResolution(resolution, kMaxFilmSide, kMaxFilmPixels);
+    } catch (const std::invalid_argument& e) {
+        std::fprintf(stderr, "%s\n", e.what());
+        return 2;
     }
     SceneDescription description = parseMitsubaScene(scenePath, parseOptions);
     if (!medium.empty()) fillWithMedium(description, parseFillMedium(medium));
-    int w = 0, h = 0;
-    if (std::sscanf(resolution.c_str(), "%dx%d", &w, &h) != 2 || w < 1 || h < 1) {
-        std::fprintf(stderr, "bad --resolution '%s'\n", resolution.c_str());
-        return 2;
-    }
     description.sensor.width = w;
     description.sensor.height = h;
     const auto scene = Scene::build(description);

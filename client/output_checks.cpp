@@ -38,8 +38,8 @@ void checkOne(const std::string& flag, const std::string& path, const std::strin
 
 }  // namespace
 
-void checkOutputPaths(const std::string& output, const std::string& preview,
-                      const std::vector<fs::path>& sceneInputs) {
+void checkOutputsAreNotInputs(const std::string& output, const std::string& preview,
+                              const std::vector<fs::path>& sceneInputs) {
     for (const auto& input : sceneInputs) {
         if (sameFile(output, input))
             throw std::invalid_argument("-o '" + output + "' is the scene's input file '" + input.string() +
@@ -48,6 +48,11 @@ void checkOutputPaths(const std::string& output, const std::string& preview,
             throw std::invalid_argument("--preview '" + preview + "' is the scene's input file '" + input.string() +
                                         "'; writing the preview there would destroy it");
     }
+}
+
+void checkOutputPaths(const std::string& output, const std::string& preview,
+                      const std::vector<fs::path>& sceneInputs) {
+    checkOutputsAreNotInputs(output, preview, sceneInputs);
     checkOne("-o", output, ".exr");
     if (!preview.empty()) {
         checkOne("--preview", preview, ".png");

@@ -24,6 +24,10 @@ namespace vrl::client {
 
 void checkOutputPaths(const std::string& output, const std::string& preview,
                       const std::vector<std::filesystem::path>& sceneInputs);
+// The last rule alone, for the files a parse of the scene found once the paths
+// themselves were checked: neither output is one of `sceneInputs`.
+void checkOutputsAreNotInputs(const std::string& output, const std::string& preview,
+                              const std::vector<std::filesystem::path>& sceneInputs);
 
 // The scene file and every file it references (includes, meshes, textures),
 // by parsing it with `defines` (cheap: meshes are not loaded). Throws SceneError.

@@ -7,6 +7,7 @@
 #include "render/core/timing.h"
 #include "render/image/exr_io.h"
 #include "render/image/preview_image.h"
+#include "service/job/scene_bundle.h"
 
 #include <spdlog/spdlog.h>
 
@@ -195,18 +196,17 @@ private:
     bool shown_ = false;
 };
 
-// Submits the scene (after every check that can fail without the coordinator's work); returns the job id.
-std::string submitScene(JobClient& client, const RenderCommandOptions& o, const RemoteOptions& remote) {
-    if (o.scene.empty())
-        throw std::invalid_argument("give a scene file to submit, or --attach JOB to re-attach to a submitted job");
-    v1::JobSpec spec = makeJobSpec(o);
+// Submits the job (resolved, its outputs checked: what remains is the coordinator's limits); returns the job id.
+std::string submitScene(JobClient& client, const RenderCommandOptions& o, const RemoteOptions& remote,
+                        const CommandLineJob* job) {
+    if (!job) throw std::invalid_argument("give a scene file to submit, or --attach JOB to re-attach to a submitted job");
+    v1::JobSpec spec = job->spec;
     spec.set_priority(remote.priority);
-    std::vector<std::filesystem::path> inputs;
-    const std::string blob = collectSceneBundle(o.scene, parseDefines(o.defines), &inputs);
-    inputs.push_back(o.scene);
-    // The callers (vrl submit, render --workers) checked the outputs at once; now against every input too.
-    checkOutputPaths(o.output, o.preview, inputs);
-    checkAgainstLimits(client.serviceInfo(), blob.size(), inputs.size(), spec, remote.address);
+    const std::string blob = rpc::makeBundleBlob(o.scene, job->sceneFiles);
+    // The files the parse met (the scene among them) and the scene once more: one more than the bundle
+    // holds, so this check refuses a bundle of exactly the coordinator's file limit, which it would take.
+    const size_t bundleFiles = job->sceneFiles.size() + 1;
+    checkAgainstLimits(client.serviceInfo(), blob.size(), bundleFiles, spec, remote.address);
     bool uploaded = false;
     spec.set_bundle_sha256(client.uploadBundle(blob, &uploaded));
     spdlog::info("scene bundle {} ({} bytes) {}", spec.bundle_sha256().substr(0, 12), blob.size(),
@@ -266,12 +266,13 @@ int unreachable(const std::string& jobId, const RemoteOptions& remote, const Ren
 
 }  // namespace
 
-int runRemoteRender(const RenderCommandOptions& o, const RemoteOptions& remote, const util::TerminationSignals& signals) {
+int runRemoteRender(const RenderCommandOptions& o, const RemoteOptions& remote, const util::TerminationSignals& signals,
+                    const CommandLineJob* job) {
     const auto start = Clock::now();
     JobClient client(remote.address, remote.tls, remote.token);
     std::string jobId = remote.attachJob;
     if (jobId.empty()) {
-        jobId = submitScene(client, o, remote);
+        jobId = submitScene(client, o, remote, job);
         if (remote.detach) {
             std::printf("%s\n", jobId.c_str());
             return 0;

@@ -16,6 +16,7 @@
 //    how to start one.
 #pragma once
 
+#include "client/command_line_job.h"
 #include "client/render_options.h"
 #include "service/common/rpc_common.h"
 #include "util/termination_signals.h"
@@ -38,8 +39,11 @@ struct RemoteOptions {
     bool partialOnSignal = false;  // render --workers: on a signal, write the finished tiles and cancel
 };
 
+// Submits `job` (resolveCommandLineJob of `o`), or with remote.attachJob watches
+// that job instead (`job` may then be null); `o` gives the outputs and -q.
 // Returns the process exit code (0 done, 1 failed/cancelled/unreachable, 2 refused
 // input, 128 + signal when interrupted).
-int runRemoteRender(const RenderCommandOptions& o, const RemoteOptions& remote, const util::TerminationSignals& signals);
+int runRemoteRender(const RenderCommandOptions& o, const RemoteOptions& remote, const util::TerminationSignals& signals,
+                    const CommandLineJob* job);
 
 }  // namespace vrl::client

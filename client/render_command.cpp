@@ -1,20 +1,20 @@
+#include "client/command_line_job.h"
 #include "client/commands.h"
 #include "client/job_client.h"
 #include "client/local_cluster.h"
 #include "client/progress_bar.h"
 #include "client/remote_render.h"
-#include "client/output_checks.h"
 #include "client/render_options.h"
-#include "util/system_memory.h"
-#include "util/termination_signals.h"
 #include "service/job/job_scene.h"
 #include "service/job/scene_bundle.h"
+#include "util/system_memory.h"
 #include "util/termination_signals.h"
 
 #include "render/core/timing.h"
 #include "render/image/exr_io.h"
 #include "render/image/partial_image.h"
 #include "render/image/preview_image.h"
+#include "render/lightcuts/cuts/surface_vpl_lightcuts_estimator.h"
 #include "render/render_metadata.h"
 #include "render/renderer.h"
 #include "render/scene/scene.h"
@@ -52,7 +52,7 @@ double peakMemoryMiB() {
 }
 
 // `--workers N`: the same render through a coordinator and N worker processes on loopback.
-int runLocalCluster(const RenderCommandOptions& o) {
+int runLocalCluster(const RenderCommandOptions& o, const CommandLineJob& job) {
     const int cores = tbb::info::default_concurrency();
     const int threadsPerWorker = o.threads > 0 ? o.threads : std::max(1, cores / o.workers);
     if (!o.quiet)
@@ -86,7 +86,7 @@ int runLocalCluster(const RenderCommandOptions& o) {
     });
     int code = 1;
     try {
-        code = runRemoteRender(o, remote, signals);
+        code = runRemoteRender(o, remote, signals, &job);
     } catch (...) {
         finished = true;
         watchdog.join();
@@ -99,32 +99,18 @@ int runLocalCluster(const RenderCommandOptions& o) {
 
 int runRender(const RenderCommandOptions& o, const CLI::App& command) {
     if (o.quiet) spdlog::set_level(spdlog::level::warn);
-    // Before any work: where the image goes (at once, from file-system metadata),
-    // then, once the scene is parsed, that it overwrites none of the scene's files.
-    checkOutputPaths(o.output, o.preview, {o.scene});
-    checkOutputPaths(o.output, o.preview, sceneInputFiles(o.scene, parseDefines(o.defines)));
-    if (o.workers > 0) {
-        // The job is checked here (crop, resolution, method ...) with the builder the
-        // coordinator will use, so that bad input exits 2 before any process starts.
-        const RenderSettings settings = resolveLocally(o).settings;
-        warnIneffectiveFlags(command, settings.method, true);
-        checkLightMemory(settings, util::physicalMemoryBytes());
-        return runLocalCluster(o);
-    }
     using Clock = std::chrono::steady_clock;
-
-    // The same builder as the coordinator's (service/job/job_scene.h), with the
-    // command line's own VRL limit in place of a coordinator's.
+    // Every refusal before any work: the outputs, the scene and the flags, checked
+    // with the builder the coordinator uses (service/job/job_scene.h), so that bad
+    // input exits 2 before a process starts or a light is traced.
     auto t0 = Clock::now();
-    const v1::JobSpec spec = makeJobSpec(o);
-    rpc::ServiceLimits limits;
-    limits.maxVrls = uint64_t(1) << 40;
-    rpc::ResolvedJob job = rpc::resolveJob(o.scene, spec, limits);
-    const SceneDescription& description = job.description;
-    const RenderSettings& settings = job.settings;
+    const CommandLineJob job = resolveCommandLineJob(o);
+    const SceneDescription& description = job.resolved.description;
+    const RenderSettings& settings = job.resolved.settings;
     const double parseSeconds = secondsSince(t0);
-    warnIneffectiveFlags(command, settings.method, false);
+    warnIneffectiveFlags(command, settings.method, o.workers > 0);
     checkLightMemory(settings, util::physicalMemoryBytes());
+    if (o.workers > 0) return runLocalCluster(o, job);
 
     t0 = Clock::now();
     const auto scene = Scene::build(description);
@@ -180,7 +166,7 @@ int runRender(const RenderCommandOptions& o, const CLI::App& command) {
     t0 = Clock::now();
     RenderRecord record;
     record.scene = o.scene;
-    record.defines.insert(spec.defines().begin(), spec.defines().end());
+    record.defines.insert(job.spec.defines().begin(), job.spec.defines().end());
     record.medium = o.medium;
     record.sceneNotes = sceneNotes(description);
     record.settings = settings;

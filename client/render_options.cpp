@@ -2,6 +2,7 @@
 
 #include "render/renderer.h"
 #include "render/description/scene_description.h"
+#include "util/command_line.h"
 
 #include <spdlog/spdlog.h>
 
@@ -201,30 +202,6 @@ void checkLightMemory(const RenderSettings& settings, uint64_t memoryBytes) {
     throw std::invalid_argument(message);
 }
 
-rpc::ResolvedJob resolveLocally(const RenderCommandOptions& o) {
-    rpc::ServiceLimits limits;
-    limits.maxVrls = uint64_t(1) << 40;  // the memory check, not a coordinator's limit, bounds it here
-    return rpc::resolveJob(o.scene, makeJobSpec(o), limits);
-}
-
-std::map<std::string, std::string> parseDefines(const std::vector<std::string>& defines) {
-    std::map<std::string, std::string> out;
-    for (const auto& d : defines) {
-        const auto eq = d.find('=');
-        if (eq == std::string::npos || eq == 0) throw std::invalid_argument("-D expects name=value, got '" + d + "'");
-        out[d.substr(0, eq)] = d.substr(eq + 1);
-    }
-    return out;
-}
-
-std::pair<int, int> parseResolution(const std::string& text) {
-    std::smatch match;
-    const std::regex pattern("^([0-9]{1,9})x([0-9]{1,9})$");
-    if (!std::regex_match(text, match, pattern))
-        throw std::invalid_argument("--resolution expects WxH (e.g. 640x480), got '" + text + "'");
-    return {std::stoi(match[1]), std::stoi(match[2])};
-}
-
 v1::RenderParameters toRenderParameters(const RenderCommandOptions& o) {
     v1::RenderParameters p;
     p.set_method(o.method);
@@ -234,11 +211,7 @@ v1::RenderParameters toRenderParameters(const RenderCommandOptions& o) {
     p.set_jitter(!o.pixelCentres);
     p.set_max_depth(o.maxDepth);
     if (!o.resolution.empty()) {
-        const auto [w, h] = parseResolution(o.resolution);
-        if (w < 1 || h < 1 || w > kMaxFilmSide || h > kMaxFilmSide || (long long)w * h > kMaxFilmPixels)
-            throw std::invalid_argument("resolution " + o.resolution + " is outside the supported range (1.." +
-                                        std::to_string(kMaxFilmSide) + " per side, at most " +
-                                        std::to_string(kMaxFilmPixels) + " pixels)");
+        const auto [w, h] = util::parseResolution(o.resolution, kMaxFilmSide, kMaxFilmPixels);
         p.set_width(uint32_t(w));
         p.set_height(uint32_t(h));
     }
@@ -270,9 +243,8 @@ v1::RenderParameters toRenderParameters(const RenderCommandOptions& o) {
     return p;
 }
 
-v1::JobSpec makeJobSpec(const RenderCommandOptions& o) {
+v1::JobSpec makeJobSpec(const RenderCommandOptions& o, const std::map<std::string, std::string>& defines) {
     v1::JobSpec spec;
-    const auto defines = parseDefines(o.defines);
     spec.mutable_defines()->insert(defines.begin(), defines.end());
     *spec.mutable_parameters() = toRenderParameters(o);
     spec.set_tile_size(o.tileSize);

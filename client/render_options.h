@@ -3,7 +3,6 @@
 #pragma once
 
 #include "render/renderer.h"
-#include "service/job/job_scene.h"
 #include "vrl/v1/vrl.pb.h"
 
 #include <CLI/CLI.hpp>
@@ -64,20 +63,13 @@ void warnIneffectiveFlags(const CLI::App& command, RenderMethod method, bool dis
 // tree of `settings` (estimateLightMemoryBytes) would not fit in `memoryBytes`.
 void checkLightMemory(const RenderSettings& settings, uint64_t memoryBytes);
 
-// The job of the flags resolved against the scene by the coordinator's own
-// builder (rpc::resolveJob, without a coordinator's limits): the method the scene
-// selects, and every JobSpecError (exit 2) before anything is started or sent.
-rpc::ResolvedJob resolveLocally(const RenderCommandOptions& o);
-
-// -D name=value list into a map; throws std::invalid_argument naming a bad entry.
-std::map<std::string, std::string> parseDefines(const std::vector<std::string>& defines);
-// "WxH" into (W, H); throws std::invalid_argument for anything else.
-std::pair<int, int> parseResolution(const std::string& text);
-// The job's parameters (width/height 0 when no --resolution).
+// The job's parameters (width/height 0 when no --resolution); throws
+// std::invalid_argument for a malformed or out-of-range --resolution or a
+// malformed --crop (the crop is checked against the film by rpc::resolveJob).
 v1::RenderParameters toRenderParameters(const RenderCommandOptions& o);
-// The whole job spec of the flags (name, defines, medium, parameters, tile
-// size; no bundle): what `vrl render` resolves in-process with
-// rpc::resolveJob and what `--workers` and `vrl submit` send.
-v1::JobSpec makeJobSpec(const RenderCommandOptions& o);
+// The whole job spec of the flags (name, `defines`, medium, parameters, tile
+// size; no bundle): what `vrl render` resolves in-process and what `--workers`
+// and `vrl submit` send (command_line_job.h builds it once).
+v1::JobSpec makeJobSpec(const RenderCommandOptions& o, const std::map<std::string, std::string>& defines);
 
 }  // namespace vrl::client

@@ -1,8 +1,8 @@
 // `vrl submit`, `vrl jobs`, `vrl cancel`, `vrl health`: the client of a running coordinator.
 #include "client/commands.h"
 
+#include "client/command_line_job.h"
 #include "client/job_client.h"
-#include "client/output_checks.h"
 #include "client/remote_render.h"
 #include "grpc/health/v1/health.grpc.pb.h"
 #include "render/description/scene_error.h"
@@ -17,6 +17,7 @@
 #include <ctime>
 #include <cstdlib>
 #include <memory>
+#include <optional>
 
 namespace vrl::client {
 
@@ -120,10 +121,11 @@ void registerServiceCommands(CLI::App& app, int& exitCode) {
         cmd->callback([o, c, remote, retryFor, noWorkerSeconds, cmd, &exitCode] {
             exitCode = guarded("submit", [&] {
                 if (o->quiet) spdlog::set_level(spdlog::level::warn);
+                // Bad input exits 2 before connecting: the outputs, the scene and the job as the coordinator will build it.
+                std::optional<CommandLineJob> job;
                 if (remote->attachJob.empty() && !o->scene.empty()) {
-                    // Bad input exits 2 before connecting: outputs at once, then the job as the coordinator will build it.
-                    checkOutputPaths(o->output, o->preview, {o->scene});
-                    warnIneffectiveFlags(*cmd, resolveLocally(*o).settings.method, true);
+                    job = resolveCommandLineJob(*o);
+                    warnIneffectiveFlags(*cmd, job->resolved.settings.method, true);
                 }
                 remote->address = c->address;
                 remote->tls = c->tls;
@@ -132,7 +134,7 @@ void registerServiceCommands(CLI::App& app, int& exitCode) {
                 remote->retryFor = std::chrono::seconds(*retryFor);
                 remote->noWorkerWarning = std::chrono::milliseconds(int64_t(*noWorkerSeconds * 1000));
                 util::TerminationSignals signals;  // Ctrl-C: leave the job running, say how to re-attach
-                return runRemoteRender(*o, *remote, signals);
+                return runRemoteRender(*o, *remote, signals, job ? &*job : nullptr);
             });
         });
     }

@@ -1,9 +1,9 @@
 #include "server/job_preparation.h"
 
 #include "render/core/timing.h"
-#include "render/lightcuts/tree/light_tree_io.h"
 #include "render/description/scene_description.h"
 #include "service/common/rpc_common.h"
+#include "service/job/job_lights_blob.h"
 #include "service/job/job_scene.h"
 #include "service/job/scene_bundle.h"
 #include "util/hash.h"
@@ -53,20 +53,7 @@ PreparedJob JobPreparation::prepare(const Job& job, const ProgressCallback& prog
         if (statistics.treeSeconds > 0.0) phases.emplace_back(kLightTreePhase, statistics.treeSeconds);
     }
     t0 = Clock::now();
-    std::vector<uint8_t> vrlBlob;  // the VRLs' blob, as a job without surface VPLs ships it alone
-    if (!lights.moreTrees.empty()) {  // vrl-stochastic with several VRL sets: all their trees in one blob
-        std::vector<const LightTree*> trees{&lights.tree};
-        for (const LightTree& tree : lights.moreTrees) trees.push_back(&tree);
-        vrlBlob = serializeLightTrees(trees);
-    } else if (lights.tree.root() >= 0) {
-        vrlBlob = serializeLightTree(lights.tree);
-    } else if (!lights.vrls.vrls.empty()) {
-        vrlBlob = serializeVrlSet(lights.vrls);
-    }
-    // Part (b)'s surface VPLs go with them in one blob, even where no VRLs are kept (--transport single).
-    const std::vector<uint8_t> blob = usesSurfaceVpls(scene.settings)
-                                          ? serializeJobLights(vrlBlob, serializeSurfaceVpls(lights.surfaceVpls))
-                                          : std::move(vrlBlob);
+    const std::vector<uint8_t> blob = rpc::encodeJobLights(lights, scene.settings);
     if (!blob.empty()) prepared.lights = std::make_shared<const std::string>(blob.begin(), blob.end());
     prepared.lightsSha = prepared.lights ? util::sha256Hex(*prepared.lights) : "";
     if (prepared.lights) phases.emplace_back("serialise lights", secondsSince(t0));

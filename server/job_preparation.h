@@ -2,10 +2,11 @@
 // (and again after a restart: the light tree is deterministic, so the tiles in
 // its checkpoint still fit). prepare() reads the bundle, loads the scene
 // (rpc::loadJobScene, the one builder of RenderSettings), traces the lights,
-// builds and serialises the light tree or VRL set, tiles the image (at most
-// limits.maxTiles tiles) and reads the checkpoint; install() puts the result on
-// the job. Queuing the missing tiles, replaying the checkpoint and publishing
-// the blobs are the Coordinator's (lease_scheduler.h, tile_assembly.h, job_store.h).
+// builds their trees, encodes them for the workers (rpc::encodeJobLights),
+// tiles the image (at most limits.maxTiles tiles) and reads the checkpoint;
+// install() puts the result on the job. Queuing the missing tiles, replaying
+// the checkpoint and publishing the blobs are the Coordinator's
+// (lease_scheduler.h, tile_assembly.h, job_store.h).
 //
 // Not thread-safe by itself: the Coordinator calls next() and install() with its
 // mutex held, and prepare() without it, on its preparation thread; prepare()
@@ -41,7 +42,7 @@ struct PreparedJob {
     std::optional<PerspectiveCamera> camera;
     RenderStatistics statistics;  // of the light work
     std::shared_ptr<const std::string> bundle;  // the bundle's blob, for workers
-    std::shared_ptr<const std::string> lights;  // serialised light tree or VRL set; null if the method has none
+    std::shared_ptr<const std::string> lights;  // the lights blob (job_lights_blob.h); null if there is none
     std::string lightsSha;                      // its SHA-256; empty if none
     std::vector<v1::TileResult> replay;         // accepted tiles from before a restart
 };

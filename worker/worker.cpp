@@ -1,6 +1,6 @@
 #include "worker/worker.h"
 
-#include "render/lightcuts/tree/light_tree_io.h"
+#include "service/job/job_lights_blob.h"
 #include "service/job/job_scene.h"
 #include "service/job/scene_bundle.h"
 #include "util/atomic_file.h"
@@ -243,30 +243,8 @@ std::shared_ptr<const Worker::JobContext> Worker::loadJob(const std::string& job
                                      "(resolution or samples); are both the same release?");
         if (!assets.lights_sha256().empty()) {
             const std::string blob = fetcher_->fetch(assets.lights_sha256(), assets.lights_size());
-            std::span<const uint8_t> primary(reinterpret_cast<const uint8_t*>(blob.data()), blob.size());
-            if (usesSurfaceVpls(context->scene.settings)) {  // the VRLs' blob and part (b)'s surface VPLs
-                const JobLightsParts parts = parseJobLights(primary.data(), primary.size());
-                if (parts.surfaceVpls.empty())
-                    throw std::runtime_error("the job's lights lack the surface VPLs its transports need");
-                context->lights.surfaceVpls = deserializeSurfaceVpls(parts.surfaceVpls.data(), parts.surfaceVpls.size());
-                primary = parts.primary;
-            }
-            const uint8_t* data = primary.data();
-            if (primary.empty()) {  // part (b) alone: no VRLs kept
-            } else if (context->scene.settings.vrlSets > 1) {  // vrl-stochastic: one tree per VRL set
-                std::vector<LightTree> trees = deserializeLightTrees(data, primary.size());
-                if (trees.size() != size_t(context->scene.settings.vrlSets))
-                    throw std::runtime_error("the job's lights hold " + std::to_string(trees.size()) +
-                                             " VRL sets, but its spec asks for " +
-                                             std::to_string(context->scene.settings.vrlSets));
-                context->lights.tree = std::move(trees[0]);
-                context->lights.moreTrees.assign(std::make_move_iterator(trees.begin() + 1),
-                                                 std::make_move_iterator(trees.end()));
-            } else if (usesLightTree(context->scene.settings.method)) {
-                context->lights.tree = deserializeLightTree(data, primary.size());
-            } else {
-                context->lights.vrls = deserializeVrlSet(data, primary.size());
-            }
+            context->lights = rpc::decodeJobLights(
+                std::span(reinterpret_cast<const uint8_t*>(blob.data()), blob.size()), context->scene.settings);
         }
         context->shader = std::make_unique<TileShader>(*context->scene.scene, context->scene.settings, context->lights);
         if (context->shader->layerNames() != std::vector<std::string>(assets.layer_names().begin(), assets.layer_names().end()))

@@ -11,6 +11,7 @@
 #include <cmath>
 #include <optional>
 #include <string>
+#include <utility>
 
 namespace vrl::rpc {
 
@@ -189,16 +190,14 @@ void validateJobSpec(const v1::JobSpec& spec, const ServiceLimits& limits) {
     if (method) checkLightCount(*method, p);
 }
 
-ResolvedJob resolveJob(const std::filesystem::path& sceneFile, const v1::JobSpec& spec, const ServiceLimits& limits,
-                       const std::filesystem::path& confineTo) {
-    validateJobSpec(spec, limits);
+namespace {
+
+// resolveJob after the spec is validated and the scene parsed.
+ResolvedJob resolveValidatedJob(SceneDescription parsed, const v1::JobSpec& spec, const ServiceLimits& limits) {
     const auto& p = spec.parameters();
-    ParseOptions options;
-    options.defines.insert(spec.defines().begin(), spec.defines().end());
-    if (!confineTo.empty()) options.confineTo = confineTo;
     ResolvedJob job;
     SceneDescription& description = job.description;
-    description = parseMitsubaScene(sceneFile, options);
+    description = std::move(parsed);
     if (!spec.medium().empty()) fillWithMedium(description, parseFillMedium(spec.medium()));
     if (p.width() > 0) {
         description.sensor.width = int(std::min<uint32_t>(p.width(), 1u << 30));
@@ -246,6 +245,22 @@ ResolvedJob resolveJob(const std::filesystem::path& sceneFile, const v1::JobSpec
         throw JobSpecError(e.what());  // settings that no method takes (several VRL sets but not vrl-stochastic, ...)
     }
     return job;
+}
+
+}  // namespace
+
+ResolvedJob resolveJob(const std::filesystem::path& sceneFile, const v1::JobSpec& spec, const ServiceLimits& limits,
+                       const std::filesystem::path& confineTo) {
+    validateJobSpec(spec, limits);
+    ParseOptions options;
+    options.defines.insert(spec.defines().begin(), spec.defines().end());
+    if (!confineTo.empty()) options.confineTo = confineTo;
+    return resolveValidatedJob(parseMitsubaScene(sceneFile, options), spec, limits);
+}
+
+ResolvedJob resolveParsedJob(SceneDescription description, const v1::JobSpec& spec, const ServiceLimits& limits) {
+    validateJobSpec(spec, limits);
+    return resolveValidatedJob(std::move(description), spec, limits);
 }
 
 JobScene loadJobScene(const std::filesystem::path& bundleDirectory, const std::filesystem::path& sceneFile,

@@ -50,6 +50,11 @@ void validateJobSpec(const v1::JobSpec& spec, const ServiceLimits& limits);
 ResolvedJob resolveJob(const std::filesystem::path& sceneFile, const v1::JobSpec& spec, const ServiceLimits& limits,
                        const std::filesystem::path& confineTo = {});
 
+// resolveJob on a scene its caller parsed (parseMitsubaScene) with the spec's
+// defines: `vrl render` parses the scene once, collecting the files it reads
+// for the bundle, before its flags become a spec.
+ResolvedJob resolveParsedJob(SceneDescription description, const v1::JobSpec& spec, const ServiceLimits& limits);
+
 // resolveJob confined to `bundleDirectory`, then builds the scene.
 JobScene loadJobScene(const std::filesystem::path& bundleDirectory, const std::filesystem::path& sceneFile,
                       const v1::JobSpec& spec, const ServiceLimits& limits);

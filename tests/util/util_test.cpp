@@ -1,8 +1,10 @@
 // util/: the leaf helpers against known values (SHA-256 and CRC-32 test
 // vectors), their failure modes (an atomic write that fails leaves the old
-// file and no temporary behind) and their contracts (random ids' alphabet).
+// file and no temporary behind) and their contracts (random ids' alphabet, the
+// command line's WxH and -D name=value with the messages `vrl render` prints).
 #include "tests/support/temp_dir.h"
 #include "util/atomic_file.h"
+#include "util/command_line.h"
 #include "util/duration.h"
 #include "util/hash.h"
 #include "util/random_id.h"
@@ -11,21 +13,20 @@
 
 #include <gtest/gtest.h>
 
+#include <pthread.h>
 #include <sys/prctl.h>
 
 #include <chrono>
 #include <csignal>
 #include <cstdlib>
-#include <stdexcept>
-
-#include <pthread.h>
-
-#include <chrono>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <set>
 #include <sstream>
 #include <stdexcept>
+#include <string>
+#include <utility>
 
 namespace vrl {
 namespace {
@@ -181,4 +182,55 @@ TEST(UtilDuration, ParsesUnitsAndRefusesTheRest) {
     EXPECT_EQ(vrl::util::formatDuration(std::chrono::milliseconds(3 * 86400 * 1000LL + 4 * 3600 * 1000LL)), "3d 4h");
     EXPECT_EQ(vrl::util::formatDuration(725s), "12m 5s");
     EXPECT_EQ(vrl::util::formatDuration(7s), "7s");
+}
+
+// The message a refusal carries, or "" if `parse` accepts.
+template <class Parse>
+std::string refusal(Parse&& parse) {
+    try {
+        parse();
+    } catch (const std::invalid_argument& e) {
+        return e.what();
+    }
+    return "";
+}
+
+TEST(UtilCommandLine, ResolutionIsWxHInDecimalDigits) {
+    using vrl::util::parseResolution;
+    EXPECT_EQ(parseResolution("640x480"), std::make_pair(640, 480));
+    EXPECT_EQ(parseResolution("1x1"), std::make_pair(1, 1));
+    EXPECT_EQ(parseResolution("007x08"), std::make_pair(7, 8));
+    EXPECT_EQ(parseResolution("0x10"), std::make_pair(0, 10));  // the range is the caller's (or the overload's)
+    EXPECT_EQ(parseResolution("999999999x999999999"), std::make_pair(999999999, 999999999));
+    for (const char* bad : {"", "x", "640", "640x", "x480", "640X480", "640*480", " 640x480", "640x480 ", "640x480\n",
+                            "-640x480", "+640x480", "640x-480", "6.4x480", "640x480x2", "1234567890x1", "1x1234567890",
+                            "0x10x"})
+        EXPECT_EQ(refusal([&] { parseResolution(bad); }),
+                  "--resolution expects WxH (e.g. 640x480), got '" + std::string(bad) + "'")
+            << bad;
+}
+
+TEST(UtilCommandLine, ResolutionInRangeOrTheRangeIsNamed) {
+    using vrl::util::parseResolution;
+    EXPECT_EQ(parseResolution("16384x4096", 16384, 64 << 20), std::make_pair(16384, 4096));
+    for (const char* bad : {"0x10", "10x0", "16385x1", "1x16385", "16384x16384"})
+        EXPECT_EQ(refusal([&] { parseResolution(bad, 16384, 64 << 20); }),
+                  "resolution " + std::string(bad) + " is outside the supported range (1..16384 per side, at most " +
+                      "67108864 pixels)")
+            << bad;
+    // A malformed size is refused for its form before its range.
+    EXPECT_EQ(refusal([] { parseResolution("100000x", 16384, 64 << 20); }),
+              "--resolution expects WxH (e.g. 640x480), got '100000x'");
+}
+
+TEST(UtilCommandLine, DefinesAreNameEqualsValue) {
+    using vrl::util::parseDefines;
+    using Defines = std::map<std::string, std::string>;
+    EXPECT_EQ(parseDefines({}), Defines{});
+    EXPECT_EQ(parseDefines({"g=0.5", "light=1", "empty=", "eq=a=b"}),
+              (Defines{{"g", "0.5"}, {"light", "1"}, {"empty", ""}, {"eq", "a=b"}}));
+    EXPECT_EQ(parseDefines({"g=0.1", "g=0.9"}), (Defines{{"g", "0.9"}}));  // the last one wins
+    for (const char* bad : {"novalue", "=1", "", "="})
+        EXPECT_EQ(refusal([&] { parseDefines({"g=1", bad}); }), "-D expects name=value, got '" + std::string(bad) + "'")
+            << bad;
 }
