@@ -148,37 +148,34 @@ void addRenderOptions(CLI::App& cmd, RenderCommandOptions& o) {
 }
 
 void warnIneffectiveFlags(const CLI::App& command, RenderMethod method, bool distributed) {
-    const bool virtualLights = usesVirtualLights(method);
-    const bool tree = usesLightTree(method);
-    const bool vrls = method == RenderMethod::Vrl || method == RenderMethod::VrlLightcuts ||
-                      method == RenderMethod::VrlStochastic;
-    const bool deterministicCut = tree && method != RenderMethod::VrlStochastic;
+    // Each flag and the setting it sets; the method table (render_method.h) says which methods read it.
     struct Rule {
         const char* flag;
-        bool effective;
-        const char* uses;  // which methods or modes it acts on
+        bool MethodReads::*setting;
+        const char* note;  // said after the methods that read it
     };
     const Rule rules[] = {
-        {"--vrls", virtualLights, "the virtual-light methods"},
-        {"--light-paths", virtualLights, "the virtual-light methods"},
-        {"--transport", virtualLights, "the virtual-light methods (path renders everything)"},
-        {"--vrl-samples", vrls, "vrl, vrl-lightcuts and vrl-stochastic"},
-        {"--error", deterministicCut, "vrl-lightcuts and vpl-lightcuts"},
-        {"--max-cut", deterministicCut, "vrl-lightcuts and vpl-lightcuts"},
-        {"--hg-epsilon", deterministicCut, "vrl-lightcuts and vpl-lightcuts"},
-        {"--partition-size", tree, "vrl-lightcuts, vrl-stochastic and vpl-lightcuts"},
-        {"--cut-size", method == RenderMethod::VrlStochastic, "vrl-stochastic"},
-        {"--exact-distance-below", method == RenderMethod::VrlLightcuts, "vrl-lightcuts"},
-        {"--glossy-heuristic", method == RenderMethod::VrlLightcuts, "vrl-lightcuts"},
-        {"--distance-samples", usesVpls(method), "vpl and vpl-lightcuts"},
-        {"--shading-points", virtualLights && method != RenderMethod::VrlStochastic,
-         "vrl, vrl-lightcuts, vpl and vpl-lightcuts (vrl-stochastic shades every sample)"},
-        {"--surface-vpls", method == RenderMethod::Vrl || method == RenderMethod::VrlLightcuts, "vrl and vrl-lightcuts"},
+        {"--vrls", &MethodReads::lightCount, ""},
+        {"--light-paths", &MethodReads::lightCount, ""},
+        {"--transport", &MethodReads::transports, " (path renders everything)"},
+        {"--vrl-samples", &MethodReads::vrlSamples, ""},
+        {"--error", &MethodReads::cutError, ""},
+        {"--max-cut", &MethodReads::cutError, ""},
+        {"--hg-epsilon", &MethodReads::cutError, ""},
+        {"--partition-size", &MethodReads::partitionSize, ""},
+        {"--cut-size", &MethodReads::stochasticCutSize, ""},
+        {"--exact-distance-below", &MethodReads::vrlClusterBounds, ""},
+        {"--glossy-heuristic", &MethodReads::vrlClusterBounds, ""},
+        {"--distance-samples", &MethodReads::vplDistanceSamples, ""},
+        {"--shading-points", &MethodReads::shadingPoints, " (vrl-stochastic shades every sample)"},
+        {"--surface-vpls", &MethodReads::surfaceVplLimit, ""},
     };
-    const std::string name(methodName(method));
+    const MethodTraits& traits = methodTraits(method);
     for (const Rule& rule : rules)
-        if (!rule.effective && command.count(rule.flag) > 0)
-            spdlog::warn("{} has no effect with --method {}: it acts on {} only", rule.flag, name, rule.uses);
+        if (!(traits.reads.*rule.setting) && command.count(rule.flag) > 0)
+            spdlog::warn("{} has no effect with --method {}: it acts on {}{} only", rule.flag, traits.name,
+                         methodsReading(rule.setting), rule.note);
+    const bool virtualLights = traits.lights != VirtualLights::None;
     if (virtualLights && command.count("--light-paths") > 0 && command.count("--vrls") > 0)
         spdlog::warn("--vrls has no effect with --light-paths: exactly the given light paths are traced");
     if (!distributed && command.get_name() == "render" && command.count("--tile-size") > 0)

@@ -35,13 +35,16 @@ void writeRenderMetadata(const RenderRecord& record, const PerspectiveCamera& ca
     if (!record.medium.empty()) metadata["vrl.medium"] = record.medium;
     for (const auto& [key, value] : record.sceneNotes) metadata[key] = value;
 
-    if (usesVirtualLights(s.method)) {
+    const MethodTraits& method = methodTraits(s.method);
+    const PartEstimators& estimators = method.estimators;
+    const bool points = method.lights == VirtualLights::Vpls;
+    if (method.lights != VirtualLights::None) {
         metadata["vrl.transport"] = s.transports.toString();
-        if (!usesVpls(s.method)) metadata["vrl.vrlSamples"] = int32_t(s.vrlSamples);
-        metadata[usesVpls(s.method) ? "vrl.vpls" : "vrl.vrls"] = double(stats.vrlCount);
+        if (method.reads.vrlSamples) metadata["vrl.vrlSamples"] = int32_t(s.vrlSamples);
+        metadata[points ? "vrl.vpls" : "vrl.vrls"] = double(stats.vrlCount);
         metadata["vrl.lightPaths"] = double(stats.lightPaths);
         metadata["vrl.time.lightTracing"] = stats.tracingSeconds;
-        if (s.method != RenderMethod::VrlStochastic && s.shadingPointsPerSide > 1)
+        if (method.reads.shadingPoints && s.shadingPointsPerSide > 1)
             metadata["vrl.shadingPoints"] = int32_t(s.shadingPointsPerSide);  // per side: K x K points
         if (usesSurfaceVpls(s)) {
             metadata["vrl.surfaceVpls"] = double(stats.surfaceVplCount);
@@ -49,50 +52,47 @@ void writeRenderMetadata(const RenderRecord& record, const PerspectiveCamera& ca
             metadata["vrl.surfaceVplPaths"] = double(stats.surfaceVplPaths);  // the light paths that deposited them
             // Part (a)'s share: the inverse square clamped at this distance (scene units).
             if (surfaceVplsLightSurfaces(s)) metadata["vrl.surfaceVplRadius"] = stats.surfaceVplRadius;
-        } else if ((s.method == RenderMethod::Vrl || s.method == RenderMethod::VrlLightcuts) &&
-                   s.transports.has(TransportPart::Single)) {
+        } else if (method.reads.surfaceVplLimit && s.transports.has(TransportPart::Single)) {
             metadata["vrl.surfaceVplLimit"] = 0.0;  // none: (b) path-samples its surface light
         }
     }
-    if (usesVpls(s.method)) metadata["vrl.vplDistanceSamples"] = int32_t(s.vplDistanceSamples);
-    if (usesLightTree(s.method)) {
-        if (s.method == RenderMethod::VrlStochastic) {
-            metadata["vrl.cutSize"] = int32_t(s.cut.stochasticCutSize);
-            metadata["vrl.vrlSets"] = int32_t(s.vrlSets);  // vrl.vrls and vrl.lightPaths count all sets
-        } else {
+    if (method.reads.vplDistanceSamples) metadata["vrl.vplDistanceSamples"] = int32_t(s.vplDistanceSamples);
+    if (method.lightTree) {
+        if (method.reads.stochasticCutSize) metadata["vrl.cutSize"] = int32_t(s.cut.stochasticCutSize);
+        if (method.reads.vrlSets) metadata["vrl.vrlSets"] = int32_t(s.vrlSets);  // vrl.vrls and vrl.lightPaths count all sets
+        if (method.reads.cutError) {
             metadata["vrl.error"] = s.cut.errorThreshold;
             metadata["vrl.maxCut"] = int32_t(s.cut.maxCutSize);
             metadata["vrl.exactDistanceBelow"] = int32_t(s.cut.bound.exactDistanceBelow);
             metadata["vrl.hgEpsilon"] = s.cut.bound.anisotropyEpsilon;
-            if (s.method == RenderMethod::VrlLightcuts) {
-                metadata["vrl.hgBound"] = std::string(s.cut.bound.hgBound == HgBound::Cones ? "cones" : "epsilon");
-                metadata["vrl.glossyBound"] =
-                    std::string(s.cut.bound.glossyBound == GlossyBound::Cones ? "cones" : "corners");
-            }
+        }
+        if (method.reads.vrlClusterBounds) {
+            metadata["vrl.hgBound"] = std::string(s.cut.bound.hgBound == HgBound::Cones ? "cones" : "epsilon");
+            metadata["vrl.glossyBound"] = std::string(s.cut.bound.glossyBound == GlossyBound::Cones ? "cones" : "corners");
         }
         metadata["vrl.partitionSize"] = int32_t(s.partitionSize);
+        // The cuts' counters (render_method.h): per pixel, or per pixel and camera sample for
+        // a stochastic cut, which counts importances instead of #Inter and has no bounds.
+        const bool stochastic = isStochastic(estimators.multiple);
         metadata["vrl.meanEval"] = stats.meanEvaluated;
-        // vrl-stochastic: per pixel and camera sample, importances instead of #Inter, no bounds.
-        const bool stochastic = s.method == RenderMethod::VrlStochastic;
         if (stochastic)
             metadata["vrl.meanImportance"] = stats.meanImportance;
         else
             metadata["vrl.meanInter"] = stats.meanIntersected;
         metadata["vrl.meanCut"] = stats.meanCutSize;
-        if (s.transports.has(TransportPart::MediumSurface) && !usesVpls(s.method)) {
+        if (s.transports.has(TransportPart::MediumSurface) && counterLayers(estimators.mediumSurface)) {
             metadata["vrl.surface.meanEval"] = stats.surfaceMeanEvaluated;
-            if (stochastic)
+            if (isStochastic(estimators.mediumSurface))
                 metadata["vrl.surface.meanImportance"] = stats.surfaceMeanImportance;
             else
                 metadata["vrl.surface.meanInter"] = stats.surfaceMeanIntersected;
             metadata["vrl.surface.meanCut"] = stats.surfaceMeanCutSize;
         }
-        if (surfaceVplsLightSingle(s)) {
+        if (surfaceVplsLightSingle(s) && counterLayers(estimators.surfaceVpls)) {
             metadata["vrl.surfaceVpl.meanEval"] = stats.surfaceVplMeanEvaluated;
             metadata["vrl.surfaceVpl.meanInter"] = stats.surfaceVplMeanIntersected;
             metadata["vrl.surfaceVpl.meanCut"] = stats.surfaceVplMeanCutSize;
         }
-
         if (!stochastic) {
             metadata["vrl.boundExceeded"] = double(stats.boundExceeded);
             metadata["vrl.boundedEstimates"] = double(stats.boundedEstimates);

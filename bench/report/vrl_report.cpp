@@ -768,17 +768,7 @@ std::string safeName(std::string s) {
     return s;
 }
 
-const char* methodTitle(RenderMethod m) {
-    switch (m) {
-        case RenderMethod::Path: return "path tracing";
-        case RenderMethod::Vrl: return "plain VRLs";
-        case RenderMethod::VrlLightcuts: return "VRL Lightcuts";
-        case RenderMethod::VrlStochastic: return "stochastic VRL Lightcuts";
-        case RenderMethod::VplLightcuts: return "VPL Lightcuts";
-        case RenderMethod::Vpl: return "plain VPLs";
-    }
-    return "?";
-}
+std::string methodTitle(RenderMethod m) { return std::string(methodTraits(m).title); }
 
 // The curves (MethodRun::curve()) a scene measured on one part, in run order.
 std::vector<std::string> curvesMeasured(const std::vector<RunResult>& results, const std::string& scene,

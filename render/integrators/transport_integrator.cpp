@@ -1,5 +1,8 @@
 #include "render/integrators/transport_integrator.h"
 
+#include "render/vrl/camera_segment.h"
+#include "render/vrl/vrl_estimator.h"
+
 #include <spdlog/spdlog.h>
 
 #include <cmath>
@@ -25,50 +28,24 @@ bool onePiece(const CameraPathSurface& a, const CameraPathSurface& b) {
 }
 }  // namespace
 
-TransportIntegrator::TransportIntegrator(const Scene& scene, const VrlSet& vrls, const TransportIntegratorSettings& settings,
-                             const LightTree* tree, const SurfaceVplLights* surfaceVpls)
+TransportIntegrator::TransportIntegrator(const Scene& scene, const VrlSet& vrls,
+                                         const TransportIntegratorSettings& settings, const LightTree* tree,
+                                         const SurfaceVplLights* surfaceVpls)
     : scene_(scene),
-      vrls_(vrls),
       settings_(settings),
       tracer_(scene, PathTracerSettings{settings.maxDepth}),
-      estimator_(scene, settings.vrlSamples),
-      surfaceEstimator_(scene, settings.vrlSamples),
-      tree_(tree),
-      surfaceVplEstimator_(scene) {
-    const bool forSingle = settings.transports.has(TransportPart::Single);
-    bool forSurface = surfaceVpls && !surfaceVpls->vpls.empty() && settings.transports.has(TransportPart::Surface);
-    if (surfaceVpls && (forSingle || forSurface) && !settings.vpls && !settings.stochastic) {
+      gatherers_(makeGatherers(scene, settings.transports, settings.estimators,
+                               GathererInputs{&vrls.vrls, tree, surfaceVpls, settings.vrlSamples, settings.cut,
+                                              settings.vplDistanceSamples})) {
+    if (const SurfaceVplLight* light = gatherers_.surfaceVpls.get()) {
+        surfaceVplsSingle_ = settings.transports.has(TransportPart::Single);
         // (a) samples the VPLs down their tree: only with one.
-        forSurface = forSurface && !surfaceVpls->tree.empty();
-        surfaceVpls_ = surfaceVpls;
-        surfaceVplsSingle_ = forSingle;
-        if (forSurface) surfaceVplRadius_ = ::vrl::surfaceVplRadius(*surfaceVpls);
-        if (!surfaceVpls->tree.empty())
-            surfaceVplLightcuts_ = std::make_unique<SurfaceVplLightcutsEstimator>(scene, *surfaceVpls,
-                                                                                  surfaceVplEstimator_, settings.cut);
-    }
-    if (settings.vpls && tree_)
-        vplLightcuts_ = std::make_unique<VplLightcutsEstimator>(scene, *tree_, settings.cut, settings.vplDistanceSamples);
-    else if (settings.vpls)
-        plainVpls_ = std::make_unique<VplEstimator>(scene, vrls.vrls, settings.vplDistanceSamples);
-    else if (tree_ && settings.stochastic)
-        stochastic_ = std::make_unique<StochasticLightcutsEstimator>(scene, *tree_, estimator_, surfaceEstimator_,
-                                                                     settings.cut);
-    else if (tree_) {
-        // One set of direction cones for both cuts' bounds, only where a medium is anisotropic.
-        // and one LeafSegments (exact distances of small nodes).
-        if (DirectionCones::neededFor(scene.media())) cones_ = std::make_unique<DirectionCones>(*tree_);
-        leaves_ = std::make_unique<LeafSegments>(*tree_);
-        lightcuts_ = std::make_unique<LightcutsEstimator>(scene, *tree_, estimator_, settings.cut, cones_.get(), leaves_.get());
-        surfaceLightcuts_ = std::make_unique<SurfaceLightcutsEstimator>(scene, *tree_, surfaceEstimator_, settings.cut,
-                                                                        cones_.get(), leaves_.get());
-    } else if (settings.transports.has(TransportPart::Multiple)) {
-        // Plain VRLs: every VRL for every segment, in SIMD lanes.
-        plainLanes_ = std::make_unique<VrlLanes>(vrls.vrls, scene);
+        if (settings.transports.has(TransportPart::Surface) && !surfaceVpls->vpls.empty() && light->hasTree())
+            surfaceVplRadius_ = ::vrl::surfaceVplRadius(*surfaceVpls);
     }
     if (settings.maxDepth >= 0 && settings.maxDepth < 16 && scene.hasSpecularSurfaces() &&
-        (settings.transports.has(TransportPart::Multiple) || surfaceVpls_ ||
-         (!settings.vpls && settings.transports.has(TransportPart::MediumSurface))))
+        (settings.transports.has(TransportPart::Multiple) || gatherers_.surfaceVpls ||
+         (vrlLitSurfaces() && settings.transports.has(TransportPart::MediumSurface))))
         spdlog::warn("maxDepth {} with specular surfaces: the VRL parts (c), (d) (and the surface VPLs' light in (a), "
                      "(b)) seen through glass or mirrors do not count the specular bounces towards maxDepth",
                      settings.maxDepth);
@@ -173,24 +150,12 @@ TransportIntegrator::VirtualLightParts TransportIntegrator::virtualLightParts(co
         const uint64_t streamKey = Rng::combine(pixelKey, segmentIndex++);
         if (scene_.media()[segment.medium].isNonScattering()) continue;
         CutStatistics& statistics = multipleStatistics ? *multipleStatistics : unused;
-        if (vplLightcuts_ || plainVpls_) {
-            // The same distance samples in both: they differ only by the cut.
-            Rng segmentRng = vrlStream(streamKey, ~0u);
-            parts.multiple += vplLightcuts_ ? vplLightcuts_->estimate(segment, segmentRng, statistics)
-                                            : plainVpls_->estimate(segment, segmentRng);
-        } else if (stochastic_) {
-            Rng segmentRng = vrlStream(streamKey, ~0u);
-            parts.multiple += stochastic_->estimate(segment, segmentRng, statistics);
-        } else if (lightcuts_) {
-            parts.multiple += lightcuts_->estimate(segment, streamKey, statistics, pathLuminance);
-        } else {
-            parts.multiple += estimator_.sumOverVrls(*plainLanes_, segment, streamKey);
-        }
+        parts.multiple += gatherers_.multiple->gather(segment, streamKey, statistics, pathLuminance);
     }
     if (surface) {
         CutStatistics& statistics = surfaceStatistics ? *surfaceStatistics : unused;
         const float other = pathLuminance + std::max(0.0f, luminance(parts.multiple));
-        if (pixel && settings_.surfacePointsSide > 1 && !stochastic_) {
+        if (pixel && settings_.surfacePointsSide > 1 && gatherers_.mediumSurface->interleaves()) {
             parts.mediumSurface = interleavedSurface(*pixel, pixelKey, statistics, other);
         } else if (path.surface) {
             if (pixel) averageTextures(*path.surface, std::span<const FilmSquare>(pixel, 1));
@@ -199,7 +164,7 @@ TransportIntegrator::VirtualLightParts TransportIntegrator::virtualLightParts(co
         }
     }
     // (b)'s surface light from the VPLs, last: its cut measures its error against the pixel's other parts.
-    if (surfaceVpls_ && surfaceVplsSingle_) {
+    if (surfaceVplsSingle_) {
         const float other = pathLuminance + std::max(0.0f, luminance(parts.multiple)) +
                             std::max(0.0f, luminance(parts.mediumSurface));
         CutStatistics& statistics = surfaceVplStatistics ? *surfaceVplStatistics : unused;
@@ -209,13 +174,8 @@ TransportIntegrator::VirtualLightParts TransportIntegrator::virtualLightParts(co
             const uint64_t streamKey = Rng::combine(pixelKey, segmentIndex++ | (uint64_t(1) << 63));
             if (scene_.media()[segment.medium].isNonScattering()) continue;
             if (settings_.maxDepth >= 0 && settings_.maxDepth < segment.specularBefore + 3) continue;
-            if (surfaceVplLightcuts_ && settings_.surfaceVplCut)
-                parts.singleSurface += surfaceVplLightcuts_->estimate(
-                    segment, streamKey, statistics, other + std::max(0.0f, luminance(parts.singleSurface)));
-            else if (surfaceVplLightcuts_)  // plain, with the VPLs' BSDFs prepared once
-                parts.singleSurface += surfaceVplLightcuts_->sumAll(segment, streamKey);
-            else
-                parts.singleSurface += sumOverSurfaceVpls(surfaceVplEstimator_, surfaceVpls_->vpls, segment, streamKey);
+            parts.singleSurface += gatherers_.surfaceVpls->alongSegment(
+                segment, streamKey, statistics, other + std::max(0.0f, luminance(parts.singleSurface)));
         }
     }
     return parts;
@@ -230,8 +190,7 @@ Rgb TransportIntegrator::surfaceVplsAtSurface(const Ray& cameraRay, Rng& rng) co
     // camera's specular bounces are not counted (the warning above), and where even x2's NEE is
     // past the limit the path tracer has nothing to hand to them either.
     if (settings_.maxDepth >= 0 && settings_.maxDepth < path.surface->specularBefore + 3) return Rgb(0.0f);
-    CutStatistics unused;
-    return surfaceVplLightcuts_->sample(*path.surface, surfaceVplRadius_, kSurfaceVplSamples, rng, unused);
+    return gatherers_.surfaceVpls->atSurface(*path.surface, surfaceVplRadius_, rng);
 }
 
 void TransportIntegrator::averageTextures(CameraPathSurface& x, std::span<const FilmSquare> squares) const {
@@ -328,20 +287,7 @@ Rgb TransportIntegrator::vrlLitSurface(const InterleavedPoints& points, uint64_t
         (!points.points[0] ||
          (settings_.maxDepth >= 0 && settings_.maxDepth < points.points[0]->specularBefore + 3)))
         return Rgb(0.0f);
-    if (surfaceLightcuts_) return surfaceLightcuts_->estimate(points, streamKey, statistics, otherLuminance);
-    if (stochastic_) {  // one point: per camera sample
-        Rng rng = vrlStream(streamKey, ~0u);
-        return stochastic_->estimate(*points.points[0], rng, statistics);
-    }
-    Rgb sum(0.0f);
-    const auto& vrls = tree_ ? tree_->vrls() : vrls_.vrls;
-    for (uint32_t k = 0; k < vrls.size(); ++k) {
-        const CameraPathSurface* x = points.at(k);
-        if (!x) continue;
-        Rng vrlRng = vrlStream(streamKey, k);
-        sum += surfaceEstimator_.contribution(vrls[k], *x, vrlRng);
-    }
-    return sum;
+    return gatherers_.mediumSurface->gather(points, streamKey, statistics, otherLuminance);
 }
 
 }  // namespace vrl

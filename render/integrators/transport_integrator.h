@@ -8,9 +8,9 @@
 //   (a) x1 on a surface, x2 not in a medium: path-traced from x1, with the
 //       camera segment's exact transmittance and the segment after x1 crossed
 //       with its exact transmittance too (no medium vertex: (c) has those).
-//       With surface VPLs (vrl, vrl-lightcuts), the light that x2 reflects by a
-//       non-Dirac lobe towards x1's non-Dirac lobes comes instead from the surface
-//       VPLs, with the inverse square clamped at distance R
+//       With surface VPLs (vrl, vrl-lightcuts; SurfaceVplLight, surface_vpl_light.h),
+//       the light that x2 reflects by a non-Dirac lobe towards x1's non-Dirac lobes
+//       comes instead from the surface VPLs, with the inverse square clamped at distance R
 //       (surface_vpl_estimator.h): per camera sample, at that sample's x1, a
 //       stochastic cut of kSurfaceVplSamples VPLs drawn down their tree in
 //       proportion to their bound (surface_vpl_lightcuts_estimator.h), unbiased. Per sample, not
@@ -26,20 +26,24 @@
 //       sampled in proportion to transmittance, a direction by the phase
 //       function, path-traced from the surface it reaches, no emission there).
 //       With surface VPLs (vrl, vrl-lightcuts: surface_vpl.h), the light that
-//       x2 reflects by a non-Dirac lobe comes instead from every surface VPL,
-//       or a cut over them (surface_vpl_lightcuts_estimator.h), against each camera segment,
-//       once per pixel; the path-traced part keeps the Dirac lobes at x2
+//       x2 reflects by a non-Dirac lobe comes instead from every surface VPL
+//       (PlainSurfaceVplLight), or a cut over them (SurfaceVplCutLight,
+//       surface_vpl_lightcuts_estimator.h), against each camera segment, once per pixel; the path-traced part keeps the Dirac lobes at x2
 //       (PathStart::diracAtFirstSurfaceOnly), the complement;
-//   (c) x1 on a surface, x2 in a medium: VRL-lit surfaces: every VRL
-//       (VrlSurfaceEstimator), a cut through the VRL tree (surface_lightcuts_estimator.h)
-//       or a stochastic cut (stochastic_lightcuts_estimator.h) at x1; once per pixel with
+//   (c) x1 on a surface, x2 in a medium: VRL-lit surfaces (a SurfaceGatherer,
+//       surface_gatherer.h): every VRL (VrlSurfaceEstimator), a cut through the VRL
+//       tree (surface_lightcuts_estimator.h) or a stochastic cut
+//       (stochastic_lightcuts_estimator.h) at x1; once per pixel with
 //       jittered rays, the VRLs are interleaved over 2 x 2 points x1 of the
 //       pixel instead (interleaved_points.h; vrl-stochastic, per camera
 //       sample, keeps the sample's own x1); the VPL methods path-trace it
 //       (their lights are points);
-//   (d) x1 and x2 in media: every VRL (--method vrl), a cut (vrl-lightcuts) or
-//       a stochastic cut (vrl-stochastic) against each camera segment, or VPLs
-//       gathered at distance samples (vpl, vpl-lightcuts).
+//   (d) x1 and x2 in media (a MediumGatherer, medium_gatherer.h): every VRL
+//       (--method vrl), a cut (vrl-lightcuts) or a stochastic cut (vrl-stochastic)
+//       against each camera segment, or VPLs gathered at distance samples (vpl,
+//       vpl-lightcuts).
+// Which estimator takes (c), (d) and the surface VPLs' light is the method's
+// PartEstimators (part_estimators.h); makeGatherers (gatherers.h) builds them once.
 // The four sets are disjoint and cover every path, so the parts add up to the
 // reference path tracer's image. Camera paths continue through purely specular
 // surfaces (camera_segment.h): parts (b)-(d) shade every medium segment of that
@@ -48,22 +52,19 @@
 // do not know each VRL's depth and ignore them (a warning says so).
 #pragma once
 
+#include "render/integrators/gatherers.h"
+#include "render/integrators/part_estimators.h"
 #include "render/integrators/path_tracer.h"
 #include "render/integrators/pixel_footprint.h"
 #include "render/integrators/transport_parts.h"
+#include "render/lightcuts/cuts/cut_settings.h"
 #include "render/lightcuts/tree/light_tree.h"
-#include "render/lightcuts/cuts/vpl_lightcuts_estimator.h"
-#include "render/lightcuts/cuts/stochastic_lightcuts_estimator.h"
-#include "render/lightcuts/cuts/surface_vpl_lightcuts_estimator.h"
-#include "render/lightcuts/cuts/surface_lightcuts_estimator.h"
-#include "render/lightcuts/cuts/lightcuts_estimator.h"
+#include "render/lightcuts/tree/surface_vpl_lights.h"
 #include "render/vrl/interleaved_points.h"
+#include "render/vrl/vpl_estimator.h"
 #include "render/vrl/vrl.h"
-#include "render/vrl/vrl_estimator.h"
-#include "render/vrl/vrl_surface_estimator.h"
 
 #include <array>
-#include <memory>
 #include <span>
 
 namespace vrl {
@@ -72,15 +73,11 @@ struct TransportIntegratorSettings {
     TransportSelection transports;
     int maxDepth = -1;
     int vrlSamples = 1;  // (u, v) samples per VRL and camera segment
-    CutSettings cut;     // used when a light tree is given
-    // The lights are VPLs: (d) is VPL Lightcuts over the tree, or plain VPLs without one.
-    bool vpls = false;
+    CutSettings cut;     // used by the cut kinds
+    // The estimator of each virtual-light part (the method table's row, render_method.h);
+    // a cut kind without a tree takes its plain kind (makeGatherers).
+    PartEstimators estimators;
     int vplDistanceSamples = kDefaultVplDistanceSamples;  // distance samples per camera segment (VPLs)
-    // With a tree: (c), (d) by stochastic cuts (stochastic_lightcuts_estimator.h) of cut.stochasticCutSize nodes.
-    bool stochastic = false;
-    // (b)'s surface VPLs by a cut over their tree (vrl-lightcuts), else every VPL; part
-    // (a) samples them down that tree in both.
-    bool surfaceVplCut = false;
     // Part (c) once per film square (virtualLightParts' `pixel`): the VRLs interleaved over
     // side x side stratified points of the square (interleaved_points.h); 1: at the camera
     // ray's own surface point. The renderer takes kInterleavedPointsSide with jittered
@@ -88,17 +85,17 @@ struct TransportIntegratorSettings {
     int surfacePointsSide = 1;
 };
 
-
 class TransportIntegrator {
 public:
-    // Parts (c), (d) sum every VRL of `vrls`, or, when `tree` is given, walk Lightcuts over it.
-    // With `surfaceVpls` (and part (b) selected), (b)'s non-Dirac surface light comes from
-    // them: a cut when they hold a tree, else every VPL.
+    // Parts (c), (d) from the VRLs (or VPLs) of `vrls`, or of `tree` for the cut kinds,
+    // by the estimators settings.estimators names. With `surfaceVpls` (and a surface-VPL
+    // kind), (b)'s non-Dirac surface light comes from them, and (a)'s share where they
+    // hold a tree.
     TransportIntegrator(const Scene& scene, const VrlSet& vrls, const TransportIntegratorSettings& settings,
-                  const LightTree* tree = nullptr, const SurfaceVplLights* surfaceVpls = nullptr);
+                        const LightTree* tree = nullptr, const SurfaceVplLights* surfaceVpls = nullptr);
 
     // The path-sampled parts for one camera ray, one sample each: (a), (b), and
-    // for the VPL methods (c). The other entries are zero.
+    // (c) where it is path-sampled (the VPL methods). The other entries are zero.
     std::array<Rgb, 4> samplePathParts(const Ray& cameraRay, Rng& rng) const;
 
     // The virtual-light parts for one camera ray: (c) at the surface the camera
@@ -124,20 +121,20 @@ public:
                                         const FilmSquare* pixel = nullptr) const;
 
     // Part (b)'s non-Dirac surface light comes from surface VPLs (virtualLightParts' singleSurface).
-    bool surfaceVplsLight() const { return surfaceVpls_ != nullptr && surfaceVplsSingle_; }
+    bool surfaceVplsLight() const { return surfaceVplsSingle_; }
     // Part (a)'s light from non-Dirac reflections at x2 comes from surface VPLs
     // (samplePathParts), with the inverse square clamped at this radius.
     bool surfaceVplsLightSurfaces() const { return surfaceVplRadius_ > 0.0f; }
     float surfaceVplRadius() const { return surfaceVplRadius_; }
 
     // Part (c) is estimated from VRLs (not path-sampled).
-    bool vrlLitSurfaces() const { return !settings_.vpls; }
-    // Whether the renderer evaluates virtualLightParts once per camera sample
+    bool vrlLitSurfaces() const { return settings_.estimators.vrlLitSurfaces(); }
+    // Whether virtualLightParts is meant to be evaluated once per camera sample
     // (with that sample's random stream and ray, averaged like (a), (b)) rather
     // than once per pixel (with the pixel's own stream (seed, pixel, ~0), in the
     // first sample pass only, so (c), (d) do not depend on the sample count):
     // true for stochastic cuts, whose (c), (d) are Monte Carlo estimates.
-    bool virtualLightsPerSample() const { return stochastic_ != nullptr; }
+    bool virtualLightsPerSample() const { return settings_.estimators.perSample(); }
 
 private:
     Rgb singleScattering(const CameraSegment& segment, Rng& rng) const;
@@ -155,25 +152,11 @@ private:
     void averageTextures(CameraPathSurface& x, std::span<const FilmSquare> squares) const;
 
     const Scene& scene_;
-    const VrlSet& vrls_;
     TransportIntegratorSettings settings_;
     VolumetricPathTracer tracer_;
-    VrlEstimator estimator_;
-    std::unique_ptr<VrlLanes> plainLanes_;  // plain VRLs only
-    VrlSurfaceEstimator surfaceEstimator_;
-    const LightTree* tree_;
-    std::unique_ptr<DirectionCones> cones_;  // vrl-lightcuts with an HG medium: shared by both cuts' bounds
-    std::unique_ptr<LeafSegments> leaves_;   // vrl-lightcuts: shared by both cuts' bounds
-    std::unique_ptr<LightcutsEstimator> lightcuts_;
-    std::unique_ptr<SurfaceLightcutsEstimator> surfaceLightcuts_;
-    std::unique_ptr<StochasticLightcutsEstimator> stochastic_;
-    std::unique_ptr<VplLightcutsEstimator> vplLightcuts_;
-    std::unique_ptr<VplEstimator> plainVpls_;
-    const SurfaceVplLights* surfaceVpls_ = nullptr;  // set only when part (a) or (b) takes light from them
-    bool surfaceVplsSingle_ = false;                 // part (b) does
-    float surfaceVplRadius_ = 0.0f;                  // > 0: part (a) does (surfaceVplRadius)
-    SurfaceVplEstimator surfaceVplEstimator_;
-    std::unique_ptr<SurfaceVplLightcutsEstimator> surfaceVplLightcuts_;
+    Gatherers gatherers_;            // (d), (c) and the surface VPLs, as settings_.estimators name them
+    bool surfaceVplsSingle_ = false;  // part (b) takes light from the surface VPLs
+    float surfaceVplRadius_ = 0.0f;   // > 0: part (a) does (surfaceVplRadius)
 };
 
 }  // namespace vrl
