@@ -15,8 +15,8 @@
 //       stochastic cut of kSurfaceVplSamples VPLs drawn down their tree in
 //       proportion to their bound (surface_vpl_lightcuts_estimator.h), unbiased. Per sample, not
 //       once per pixel: the sample's own x1 averages the pixel's footprint as the
-//       path tracer does (once per pixel, a pixel half on a lamp's bright inside
-//       came out either bright or dark). The path-traced part keeps x2's
+//       path tracer does (one x1 per pixel would leave a pixel that straddles a
+//       bright edge all bright or all dark). The path-traced part keeps x2's
 //       emission, its Dirac lobes, the reflection of an x2 whose lobe is narrow
 //       (reflectsBroadly) and, for x2 within R of x1, the share the clamp
 //       leaves out (PathStart::surfaceVplRadius);

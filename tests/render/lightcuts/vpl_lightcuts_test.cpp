@@ -3,6 +3,7 @@
 // point-cluster light tree, the exactness of a cut at error threshold 0, the
 // conservativeness of the node bound, and the rendered part (d) against plain
 // VRLs over the same light paths, plus determinism.
+#include "render/core/distance.h"
 #include "render/core/rng.h"
 #include "render/lightcuts/tree/light_tree.h"
 #include "render/lightcuts/cuts/vpl_lightcuts_estimator.h"
