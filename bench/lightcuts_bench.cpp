@@ -23,6 +23,7 @@
 // the same relative RMSE (log-log interpolation between its bracketing points)
 // over the heuristic's time: the "slower at equal error" ratio.
 #include "bench/bench_lights.h"
+#include "bench/bench_scene_arguments.h"
 #include "render/core/timing.h"
 #include "render/description/scene_description.h"
 #include "render/image/image_metrics.h"
@@ -219,15 +220,10 @@ int main(int argc, char** argv) {
     const bool surfacePart = part == "medium-surface";
     if (verbose) spdlog::set_level(spdlog::level::debug);
 
-    ParseOptions parseOptions;
-    int w = 0, h = 0;
-    try {
-        parseOptions.defines = util::parseDefines(defines);
-        std::tie(w, h) = util::parseResolution(resolution, kMaxFilmSide, kMaxFilmPixels);
-    } catch (const std::invalid_argument& e) {
-        std::fprintf(stderr, "%s\n", e.what());
-        return 2;
-    }
+    const auto arguments = bench::parseSceneArguments(defines, resolution);
+    if (!arguments) return 2;
+    const ParseOptions& parseOptions = arguments->parseOptions;
+    const int w = arguments->width, h = arguments->height;
     // The built-in test scenes (tests/support/test_scenes.h): `lit-room`, the lit room
     // with its occluder (isotropic, sigma_s 0.4, sigma_a 0.1; -D g=... sets HG), and
     // `infinite`, a point light in an unbounded medium (no surfaces: no occlusion rays).

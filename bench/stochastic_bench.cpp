@@ -33,6 +33,7 @@
 // Timings are wall-clock, one run each, on whatever cores TBB gets: compare
 // ratios within one run, not seconds.
 #include "bench/bench_lights.h"
+#include "bench/bench_scene_arguments.h"
 #include "bench/stochastic_ceiling.h"
 #include "render/core/timing.h"
 #include "render/description/scene_description.h"
@@ -415,15 +416,10 @@ int main(int argc, char** argv) {
         return 2;
     }
 
-    ParseOptions parseOptions;
-    int w = 0, h = 0;
-    try {
-        parseOptions.defines = util::parseDefines(defines);
-        std::tie(w, h) = util::parseResolution(resolution, kMaxFilmSide, kMaxFilmPixels);
-    } catch (const std::invalid_argument& e) {
-        std::fprintf(stderr, "%s\n", e.what());
-        return 2;
-    }
+    const auto arguments = bench::parseSceneArguments(defines, resolution);
+    if (!arguments) return 2;
+    const ParseOptions& parseOptions = arguments->parseOptions;
+    const int w = arguments->width, h = arguments->height;
     SceneDescription description = parseMitsubaScene(scenePath, parseOptions);
     if (!medium.empty()) fillWithMedium(description, parseFillMedium(medium));
     description.sensor.width = w;
