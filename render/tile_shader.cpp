@@ -87,8 +87,11 @@ TileShader::TileShader(const Scene& scene, const RenderSettings& settings, const
     checkLightsMatchScene(scene, lights);
     const MethodTraits& method = methodTraits(settings.method);
     if (method.lights != VirtualLights::None) {
-        TransportIntegratorSettings integratorSettings{settings.transports, settings.maxDepth, settings.vrlSamples,
-                                                       settings.cut};
+        TransportIntegratorSettings integratorSettings;
+        integratorSettings.transports = settings.transports;
+        integratorSettings.maxDepth = settings.maxDepth;
+        integratorSettings.vrlSamples = settings.vrlSamples;
+        integratorSettings.cut = settings.cut;
         integratorSettings.estimators = method.estimators;
         integratorSettings.vplDistanceSamples = settings.vplDistanceSamples;
         // (c) once per pixel over interleaved points of the pixel; at pixel centres, the centre's alone.

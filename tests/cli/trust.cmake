@@ -8,10 +8,13 @@ file(MAKE_DIRECTORY ${TRUST_DIR})
 # A copy of the scene to aim -o at: if the check ever regresses, only the copy is lost.
 configure_file(${TRUST_SCENE} ${TRUST_DIR}/scene-copy.xml COPYONLY)
 
-# Outputs: refused with exit 2, naming the path and the reason, within 2 s (timeout exits 124).
+# Outputs: refused with exit 2, naming the path and the reason, within 2 s (timeout exits 124);
+# the two timed ones are labelled `timed` (the sanitizer job leaves them out: instrumentation
+# slows start-up; cli.unwritable_output and cli.preview_missing_folder_refused check the same untimed).
 add_test(NAME cli.output_missing_folder_refused_fast
   COMMAND ${CLI_CHECK} 2 "no/such/dir/x.exr.*folder '/no/such/dir' does not exist"
           timeout 2 ${VRL_CLI} render ${TRUST_SCENE} -o /no/such/dir/x.exr)
+set_tests_properties(cli.output_missing_folder_refused_fast PROPERTIES LABELS "e2e;timed")
 add_test(NAME cli.output_is_the_scene_refused
   COMMAND ${CLI_CHECK} 2 "scene-copy.xml' is the scene's input file"
           ${VRL_CLI} render ${TRUST_DIR}/scene-copy.xml -o ${TRUST_DIR}/scene-copy.xml)
@@ -31,10 +34,12 @@ file(MAKE_DIRECTORY ${TRUST_DIR}/folder.exr)
 add_test(NAME cli.submit_output_checked_before_connecting
   COMMAND ${CLI_CHECK} 2 "folder '/no/such/dir' does not exist"
           timeout 2 ${VRL_CLI} submit ${TRUST_SCENE} -o /no/such/dir/x.exr --coordinator 127.0.0.1:9)
+set_tests_properties(cli.submit_output_checked_before_connecting PROPERTIES LABELS "e2e;timed")
 
 # Interrupts: partial EXR with coverage, exit 130/143, a second Ctrl-C quits at once.
 add_test(NAME cli.interrupt_keeps_partial_image
   COMMAND ${CMAKE_CURRENT_SOURCE_DIR}/cli/interrupt_test.sh ${VRL_CLI} ${TRUST_SCENE} ${TRUST_DIR}/interrupt)
+set_tests_properties(cli.interrupt_keeps_partial_image PROPERTIES COST 35)
 
 # No silent mistakes.
 add_test(NAME cli.flag_without_effect_warns_error_with_path
@@ -68,6 +73,7 @@ add_test(NAME cli.coordinator_threads_zero_documented
 # Defaults: headline method, jitter, single-channel counters, VPL naming, quiet, stdout.
 add_test(NAME cli.defaults_and_streams
   COMMAND ${CMAKE_CURRENT_SOURCE_DIR}/cli/defaults_test.sh ${VRL_CLI} ${TRUST_SCENE} ${TRUST_DIR}/defaults)
+set_tests_properties(cli.defaults_and_streams PROPERTIES COST 45)
 
 # The job is built locally by the coordinator's own builder before anything starts or is sent:
 # a crop outside the film is bad input (exit 2) for --workers and submit as for the embedded render.
