@@ -64,7 +64,7 @@ void expectBitIdentical(const ImageSet& expected, const ImageSet& actual) {
     EXPECT_TRUE(same(expected.image, actual.image)) << "image differs";
     for (const auto& [name, layer] : expected.layers) {  // an EXR file lists its layers by name
         const auto found = std::find_if(actual.layers.begin(), actual.layers.end(),
-                                        [&](const auto& entry) { return entry.first == name; });
+                                        [&layerName = name](const auto& entry) { return entry.first == layerName; });
         ASSERT_NE(found, actual.layers.end()) << "layer " << name << " missing";
         EXPECT_TRUE(same(layer, found->second)) << "layer " << name;
     }
