@@ -73,7 +73,7 @@ add_test(NAME cli.coordinator_threads_zero_documented
 # Defaults: headline method, jitter, single-channel counters, VPL naming, quiet, stdout.
 add_test(NAME cli.defaults_and_streams
   COMMAND ${CMAKE_CURRENT_SOURCE_DIR}/cli/defaults_test.sh ${VRL_CLI} ${TRUST_SCENE} ${TRUST_DIR}/defaults)
-set_tests_properties(cli.defaults_and_streams PROPERTIES COST 45)
+set_tests_properties(cli.defaults_and_streams PROPERTIES LABELS heavy COST ${VRL_HEAVY_COST})
 
 # The job is built locally by the coordinator's own builder before anything starts or is sent:
 # a crop outside the film is bad input (exit 2) for --workers and submit as for the embedded render.
