@@ -80,7 +80,9 @@ Rgb VolumetricPathTracer::radiance(Ray ray, int medium, Rng& rng, const PathStar
             throughput *= scene_.media()[medium].transmittance(tSurface - segmentStart);
         } else if (medium >= 0) {
             const HomogeneousMedium& m = scene_.media()[medium];
-            const FreeFlightSample flight = m.sampleFreeFlight(tSurface - segmentStart, rng.next(), rng.next());
+            // uDistance first: the order of the draws fixed in the source, not by the compiler.
+            const float uDistance = rng.next(), uChannel = rng.next();
+            const FreeFlightSample flight = m.sampleFreeFlight(tSurface - segmentStart, uChannel, uDistance);
             throughput *= flight.weight;
             if (bsdfPdf > 0.0f && !flight.scattered) bsdfTransmittance *= m.transmittance(tSurface - segmentStart);
             if (flight.scattered) {
@@ -92,12 +94,26 @@ Rgb VolumetricPathTracer::radiance(Ray ray, int medium, Rng& rng, const PathStar
                 if (!mayScatterAgain()) break;
                 const Vec3 x = ray.at(segmentStart + flight.t);
                 const DirectLighting direct = sampleDirectLighting(scene_, x, nullptr, medium, rng);
-                if (counts() && !isBlack(direct.radianceOverPdf))
-                    result += throughput * direct.radianceOverPdf * m.phase().eval(ray.direction, direct.direction);
+                if (counts() && !isBlack(direct.radianceOverPdf)) {
+                    const float phase = m.phase().eval(ray.direction, direct.direction);
+                    // An area light is also found by the phase sample below (MIS, as at surfaces):
+                    // NEE alone carries 1 / d^2 next to an emitting wall, of unbounded variance.
+                    const float weight = settings_.lightMis && direct.pdf > 0.0f
+                                             ? powerHeuristic(direct.pdf, phase * passProbability(direct.transmittance, false))
+                                             : 1.0f;
+                    result += throughput * direct.radianceOverPdf * (phase * weight);
+                }
                 // Exact phase sampling: the weight f/pdf is 1.
                 const PhaseSample next = m.phase().sample(ray.direction, Vec2(rng.next(), rng.next()));
                 ray = Ray{x, next.direction};
                 segmentStart = 0.0f;
+                // An emitter this ray reaches unscattered counts where NEE from x did (counts()),
+                // with the complementary weight.
+                emissionCounts = settings_.lightMis && counts();
+                bsdfPdf = emissionCounts ? next.pdf : 0.0f;
+                bsdfFrom = x;
+                bsdfPassesSurely = false;
+                bsdfTransmittance = Rgb(1.0f);
                 if (vertices >= settings_.rouletteDepth) {
                     const float q = std::min(maxComponent(throughput), 0.95f);
                     if (rng.next() >= q) break;
@@ -162,7 +178,7 @@ Rgb VolumetricPathTracer::radiance(Ray ray, int medium, Rng& rng, const PathStar
                 // under the same condition (counts(), no medium collision on the way).
                 const bool passesSurely = atX1 && start.afterFirstSurface == After::NotInMedium;
                 const float weight =
-                    settings_.surfaceMis && direct.pdf > 0.0f
+                    settings_.lightMis && direct.pdf > 0.0f
                         ? powerHeuristic(direct.pdf, bsdf.pdf(sp, wo, direct.direction) *
                                                          passProbability(direct.transmittance, passesSurely))
                         : 1.0f;
@@ -179,7 +195,7 @@ Rgb VolumetricPathTracer::radiance(Ray ray, int medium, Rng& rng, const PathStar
         if (atX1 && !sampled->delta && start.surfaceVplRadius > 0.0f && afterX1 == After::NotInMedium &&
             lambertianBounded(bsdf))
             x1ForVpls = hit->position;
-        const bool misEmission = settings_.surfaceMis && !sampled->delta;
+        const bool misEmission = settings_.lightMis && !sampled->delta;
         emissionCounts = (sampled->delta || misEmission) && (!restricted || vertices >= 2) && afterX1 != After::InMedium;
         bsdfPdf = misEmission ? sampled->pdf : 0.0f;
         bsdfFrom = hit->position;

@@ -1,25 +1,30 @@
 // VolumetricPathTracer: the reference estimator. Unidirectional path tracing
-// through homogeneous media (free-flight sampling with spectral MIS) and the
-// surface models of bsdf.h, with next-event estimation at every medium vertex and
-// every surface vertex with a non-Dirac lobe. Emission counts with weight 1 where
-// NEE cannot reach it (camera rays, rays that only crossed null boundaries, rays
-// leaving a sampled Dirac lobe). At a surface vertex, an area light is found by
-// both strategies: NEE (density p_light = emitter choice x sampleDirect's
-// solid-angle pdf) and a BSDF-sampled ray that reaches the light without a medium
-// collision (density p_bsdf = Bsdf::pdf of the non-Dirac lobes, as sample() draws
-// them); each counts with the power heuristic p^2 / (p_light^2 + p_bsdf^2), so
-// the weights of a path sum to 1 (Veach 1997 §9.2; pbrt-v4 VolPathIntegrator).
-// The BSDF strategy's density in the weights includes the chance that its ray
-// crosses the media to the light unscattered (the average over channels of the
-// transmittance, as free-flight sampling with spectral MIS passes; 1 where the
-// segment is crossed by transmittance alone), so that where the segment to the
-// light has optical depth ~1 the BSDF ray's coin-flip pass-through weighs less.
-// On glossy surfaces MIS is far quieter than NEE alone (0.01-0.5x). In the
-// glossy test room with thick media it is not clearly better: both estimators
-// are heavy-tailed there, and NEE alone measured 0.6k and 510k of per-path
-// variance at 2048 and 4096 paths per pixel, MIS 1.7k and 1.6k.
-// Point and spot lights (Dirac) and medium
-// vertices keep NEE alone, weight 1. Unbiased for every light in the scene subset.
+// through homogeneous media (free-flight sampling with spectral MIS:
+// homogeneous_medium.h) and the surface models of bsdf.h, with next-event
+// estimation at every medium vertex and every surface vertex with a non-Dirac
+// lobe. Emission counts with weight 1 where NEE cannot reach it (camera rays,
+// rays that only crossed null boundaries, rays leaving a sampled Dirac lobe). At
+// a medium vertex, and at a surface vertex with a non-Dirac lobe, an area light is
+// found by both strategies: NEE (density p_light = emitter choice x sampleDirect's
+// solid-angle pdf) and the phase- or BSDF-sampled ray that reaches the light
+// without a medium collision (density p_dir = the phase function, or Bsdf::pdf of
+// the non-Dirac lobes as sample() draws them); each counts with the power
+// heuristic p^2 / (p_light^2 + p_dir^2), so the weights of a path sum to 1 (Veach
+// 1997 §9.2; pbrt-v4 VolPathIntegrator). The directional strategy's density in
+// the weights includes the chance that its ray crosses the media to the light
+// unscattered (the average over channels of the transmittance, as free-flight
+// sampling passes; 1 where the segment is crossed by transmittance alone), so
+// that where the segment to the light has optical depth ~1 its coin-flip
+// pass-through weighs less. NEE alone from a medium vertex carries 1 / d^2 next to
+// an emitting surface, whose variance is unbounded: in the emitting-sphere furnace
+// with a dense chromatic medium it missed the answer by 4 standard errors and
+// more; the phase strategy caps it (its density is bounded). On glossy surfaces MIS
+// is far quieter than NEE alone (0.01-0.5x). In the glossy test room with thick
+// media it is not clearly better: both estimators are heavy-tailed there, and NEE
+// alone measured 0.6k and 510k of per-path variance at 2048 and 4096 paths per
+// pixel, MIS 1.7k and 1.6k. Point and spot lights (Dirac) keep NEE alone, weight
+// 1. PathTracerSettings::lightMis = false is NEE alone everywhere. Unbiased for
+// every light in the scene subset.
 //
 // Path length follows Mitsuba's maxDepth: a path of k scattering vertices has
 // k+1 segments; 1 = directly visible emitters, 2 = + direct lighting and single
@@ -37,10 +42,10 @@ struct PathTracerSettings {
     // Count only paths whose first two camera-side vertices lie in a medium
     // (the paths VRLs estimate); everything else is dropped.
     bool onlyMediumToMedium = false;
-    // Multiple importance sampling of NEE and BSDF sampling at surface vertices; false
-    // is the NEE-only estimator (same expectation, more variance on glossy surfaces),
-    // kept to compare the two.
-    bool surfaceMis = true;
+    // Multiple importance sampling of NEE and BSDF (or phase) sampling at surface and
+    // medium vertices; false is the NEE-only estimator (same expectation, more variance
+    // on glossy surfaces and next to emitting surfaces), kept to compare the two.
+    bool lightMis = true;
 };
 
 // Where a path starts, for estimators that hand part of a path to the tracer.
