@@ -202,10 +202,8 @@ std::string submitScene(JobClient& client, const RenderCommandOptions& o, const 
     if (!job) throw std::invalid_argument("give a scene file to submit, or --attach JOB to re-attach to a submitted job");
     v1::JobSpec spec = job->spec;
     spec.set_priority(remote.priority);
-    const std::string blob = rpc::makeBundleBlob(o.scene, job->sceneFiles);
-    // The files the parse met (the scene among them) and the scene once more: one more than the bundle
-    // holds, so this check refuses a bundle of exactly the coordinator's file limit, which it would take.
-    const size_t bundleFiles = job->sceneFiles.size() + 1;
+    size_t bundleFiles = 0;  // the bundle's entries: the files the parse met, each once, the scene among them
+    const std::string blob = rpc::makeBundleBlob(o.scene, job->sceneFiles, &bundleFiles);
     checkAgainstLimits(client.serviceInfo(), blob.size(), bundleFiles, spec, remote.address);
     bool uploaded = false;
     spec.set_bundle_sha256(client.uploadBundle(blob, &uploaded));

@@ -14,7 +14,7 @@ namespace vrl::rpc {
 
 namespace fs = std::filesystem;
 
-std::string makeBundleBlob(const fs::path& scene, const std::vector<fs::path>& files) {
+std::string makeBundleBlob(const fs::path& scene, const std::vector<fs::path>& files, size_t* entries) {
     std::vector<fs::path> absolute;
     for (const auto& file : files) {
         std::error_code error;
@@ -48,6 +48,7 @@ std::string makeBundleBlob(const fs::path& scene, const std::vector<fs::path>& f
         entry->set_path(relative);
         entry->set_data(data.str());
     }
+    if (entries) *entries = size_t(bundle.entries_size());
     std::string blob;
     bundle.SerializeToString(&blob);
     return blob;

@@ -23,8 +23,10 @@ struct BundleError : std::runtime_error {
 // Builds the blob from files on disk: `files` (absolute or relative to the
 // working directory) become entries relative to their deepest common
 // directory; `scene` must be one of them. Throws BundleError for a file that
-// is a symbolic link or cannot be read.
-std::string makeBundleBlob(const std::filesystem::path& scene, const std::vector<std::filesystem::path>& files);
+// is a symbolic link or cannot be read. `entries`, if given, receives the number of
+// entries (a file listed twice is one entry): what the coordinator's file limit counts.
+std::string makeBundleBlob(const std::filesystem::path& scene, const std::vector<std::filesystem::path>& files,
+                           size_t* entries = nullptr);
 
 // Parses and validates a blob; throws BundleError.
 v1::SceneBundle parseBundleBlob(const std::string& blob, const ServiceLimits& limits);

@@ -4,6 +4,8 @@
 #  - a bad --retention is refused (exit 2, naming the flag);
 #  - a bundle over the coordinator's --max-bundle-mib is refused before any upload
 #    (exit 2, size, limit and flag), as is neither a scene nor --attach;
+#  - a bundle of exactly the coordinator's --max-files is taken, one file more refused
+#    before upload (the client counts the bundle's entries as the coordinator does);
 #  - J=$(vrl submit --detach ...) captures exactly the job id;
 #  - with no worker, one hint how to start one; Ctrl-C leaves the job running and
 #    prints the commands to re-attach and cancel (exit 130), SIGTERM likewise (143);
@@ -62,6 +64,39 @@ echo "$out" | grep -Eq "scene bundle is 1\.[0-9] MiB .*over the limit of 1\.0 Mi
   || fail "the refusal does not give the size, the limit and the flag: $out"
 ls "$work/state/bundles/"*.bundle > /dev/null 2>&1 && fail "a bundle was uploaded although refused"
 pass "oversized bundle refused before upload (exit 2): $out"
+
+# 2b. --max-files: the client's count is the bundle's. The refusal at --max-files 1 names the
+# count N; a coordinator with --max-files N takes the bundle, one with N - 1 refuses it.
+files_coordinator() {  # files_coordinator LIMIT ADDRESS: a coordinator of that file limit, up
+  "$coordinator_bin" --listen "$2" --state-dir "$work/files-$1" --threads 1 --max-files "$1" \
+    --log-level info >> "$work/coordinator-files.log" 2>&1 &
+  pids+=("$!")
+  local deadline=$((SECONDS + 20))
+  until "$vrl" health --address "$2" > /dev/null 2>&1; do
+    [ "$SECONDS" -ge "$deadline" ] && fail "the coordinator with --max-files $1 did not come up"
+    sleep 0.1
+  done
+}
+files_addr=127.0.0.1:$(free_port)
+files_coordinator 1 "$files_addr"
+out=$("$vrl" submit --detach "$scene" --coordinator "$files_addr" -o "$work/f.exr" "${flags[@]}" 2>&1); code=$?
+[ "$code" -eq 2 ] || fail "a bundle over --max-files 1: exit $code, expected 2: $out"
+count=$(echo "$out" | sed -nE 's/.*scene bundle holds ([0-9]+) files, over the limit of 1.*/\1/p')
+[ -n "$count" ] && [ "$count" -ge 2 ] || fail "the --max-files refusal does not name the count: $out"
+{ kill -9 "${pids[-1]}"; wait "${pids[-1]}"; } 2>/dev/null
+files_addr=127.0.0.1:$(free_port)
+files_coordinator "$count" "$files_addr"
+F=$("$vrl" submit --detach "$scene" --coordinator "$files_addr" -o "$work/f.exr" "${flags[@]}" 2> "$work/files.err") \
+  || fail "a bundle of exactly --max-files $count was refused: $(cat "$work/files.err")"
+[[ "$F" =~ ^job-[0-9a-f]{12}$ ]] || fail "submit at exactly --max-files $count printed '$F'"
+{ kill -9 "${pids[-1]}"; wait "${pids[-1]}"; } 2>/dev/null
+files_addr=127.0.0.1:$(free_port)
+files_coordinator $((count - 1)) "$files_addr"
+out=$("$vrl" submit --detach "$scene" --coordinator "$files_addr" -o "$work/f.exr" "${flags[@]}" 2>&1); code=$?
+[ "$code" -eq 2 ] && [[ "$out" == *"holds $count files, over the limit of $((count - 1))"* ]] \
+  || fail "a bundle of $count files at --max-files $((count - 1)): exit $code: $out"
+{ kill -9 "${pids[-1]}"; wait "${pids[-1]}"; } 2>/dev/null
+pass "a bundle of $count files: taken at --max-files $count, refused at $((count - 1)) before upload"
 
 # 3. Neither a scene nor --attach.
 out=$("$vrl" submit --coordinator "$addr" -o "$work/x.exr" 2>&1); code=$?
