@@ -16,10 +16,10 @@
 // sampling passes; 1 where the segment is crossed by transmittance alone), so
 // that where the segment to the light has optical depth ~1 its coin-flip
 // pass-through weighs less. NEE alone from a medium vertex carries 1 / d^2 next to
-// an emitting surface, whose variance is unbounded: in the emitting-sphere furnace
-// with a dense chromatic medium it missed the answer by 4 standard errors and
-// more; the phase strategy caps it (its density is bounded). On glossy surfaces MIS
-// is far quieter than NEE alone (0.01-0.5x). In the glossy test room with thick
+// an emitting surface, whose variance is unbounded (in PathTracerFurnace's chromatic
+// case its standard errors ran up to 10x those with MIS, and missed the answer for
+// some seeds); the phase strategy caps it (its density is bounded). On
+// glossy surfaces MIS is far quieter than NEE alone (0.01-0.5x). In the glossy test room with thick
 // media it is not clearly better: both estimators are heavy-tailed there, and NEE
 // alone measured 0.6k and 510k of per-path variance at 2048 and 4096 paths per
 // pixel, MIS 1.7k and 1.6k. Point and spot lights (Dirac) keep NEE alone, weight
